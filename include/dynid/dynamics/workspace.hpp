@@ -1,0 +1,35 @@
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "dynid/model/model.hpp"
+
+namespace dynid {
+
+/// Per-link kinematic state, every vector expressed in link frame j (monogram: _J).
+struct LinkState {
+  Eigen::Matrix3d R_PJ;  ///< orientation of frame j in its parent frame at the current q
+  Eigen::Vector3d p_PJ;  ///< origin of frame j in its parent frame at the current q [m]
+  Eigen::Matrix3d R_WJ;  ///< orientation of frame j in the base (world) frame
+  Eigen::Vector3d p_WJ;  ///< origin of frame j in the base frame [m]
+  Eigen::Vector3d w;     ///< angular velocity of link j [rad/s]
+  Eigen::Vector3d v;     ///< linear velocity of origin j [m/s]
+  Eigen::Vector3d dw;    ///< angular acceleration [rad/s²]
+  Eigen::Vector3d a;     ///< linear acceleration of origin j MINUS gravity [m/s²] (gravity trick)
+  Eigen::Vector3d f;     ///< force link parent(j) exerts on link j (backward pass) [N]
+  Eigen::Vector3d n;     ///< moment about origin j that parent(j) exerts on link j [N·m]
+};
+
+/// Reusable scratch memory for one model and one thread. Construct once, pass to every call: the
+/// algorithms then never allocate.
+struct Workspace {
+  explicit Workspace(const Model& model);
+  std::vector<LinkState> links;
+  Eigen::MatrixXd scratch_nn;   ///< n×n scratch (mass matrix, factorisations)
+  Eigen::VectorXd scratch_n;    ///< n scratch
+  Eigen::VectorXd scratch_n2;   ///< n scratch
+};
+
+}  // namespace dynid

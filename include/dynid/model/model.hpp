@@ -1,0 +1,98 @@
+#pragma once
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace dynid {
+
+/// One-DoF joint kinds. Fixed joints never reach a Model: loaders merge them into the parent link.
+enum class JointType { kRevolute, kPrismatic };
+
+/// Number of standard inertial parameters per link (DESIGN.md section 3).
+inline constexpr int kLinkParams = 10;
+
+/// Standard inertial parameters of one link, in link frame j, about the link ORIGIN, in the order
+/// XX XY XZ YY YZ ZZ MX MY MZ M (kg·m², kg·m, kg). MX = m·c_x.
+using LinkParams = Eigen::Matrix<double, kLinkParams, 1>;
+
+/// Joint-side actuator and friction terms: tau += Ia·ddq + Fv·dq + Fc·sign(dq) + Fo.
+struct JointFriction {
+  double Ia = 0.0;  ///< actuator (rotor) inertia reflected to the joint [kg·m² or kg]
+  double Fv = 0.0;  ///< viscous coefficient [N·m·s/rad or N·s/m]
+  double Fc = 0.0;  ///< Coulomb level [N·m or N]
+  double Fo = 0.0;  ///< constant offset [N·m or N]
+};
+
+/// Joint limits; absent limits are +/- infinity.
+struct JointLimits {
+  double lower = -std::numeric_limits<double>::infinity();     ///< [rad or m]
+  double upper = std::numeric_limits<double>::infinity();      ///< [rad or m]
+  double velocity = std::numeric_limits<double>::infinity();   ///< [rad/s or m/s]
+  double effort = std::numeric_limits<double>::infinity();     ///< [N·m or N]
+};
+
+/// Joint j connects link parent (-1 = the fixed base) to link j. Frame convention (URDF): the pose
+/// of link frame j in its parent's frame is X_PJ(q) = (R_PJ, p_PJ) · motion(axis, q), where the
+/// motion is a rotation by q about `axis` (revolute) or a translation q·axis (prismatic), axis given
+/// in frame j. Modified DH rows map onto the same form (docs/notation.md).
+struct Joint {
+  std::string name;
+  std::string link_name;
+  JointType type = JointType::kRevolute;
+  int parent = -1;
+  Eigen::Matrix3d R_PJ = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d p_PJ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< unit vector in frame j
+  JointLimits limits;
+  JointFriction friction;
+};
+
+/// Motor <-> joint transmission (DESIGN.md section 3): q_motor = N·(q - q_offset), so
+/// q = N⁻¹·q_motor + q_offset, and tau_joint = Nᵀ·tau_motor. N is n×n, identity by default.
+struct Transmission {
+  Eigen::MatrixXd N;          ///< n×n, invertible
+  Eigen::VectorXd q_offset;   ///< n, added to the joint angles after N⁻¹ [rad or m]
+  bool is_identity() const;
+};
+
+/// An immutable kinematic tree with inertial, actuator and friction parameters. Built by the
+/// loaders (URDF, MDH YAML) or by hand followed by finalize(); every algorithm takes it by const&.
+/// Joint order is the index j used everywhere (columns, parameter names): parents precede children.
+struct Model {
+  std::string name;
+  std::vector<Joint> joints;
+  std::vector<LinkParams> links;                       ///< one per joint, standard order
+  Eigen::Vector3d gravity{0.0, 0.0, -9.81};            ///< in the base frame [m/s²]
+  Transmission transmission;
+  std::string source;                                  ///< file or built-in name it came from
+
+  int dof() const { return static_cast<int>(joints.size()); }
+
+  /// Checks consistency (parents precede children, unit axes, orthonormal rotations, sizes,
+  /// physical inertias: m ≥ 0 and the rotational inertia about the centre of mass positive
+  /// semi-definite with the triangle inequality) and fills defaults (identity transmission).
+  /// Throws dynid::Error naming the joint or link at fault.
+  void finalize();
+
+  /// The standard parameter vector theta (10 per link, DESIGN.md section 3 order), size 10·n.
+  Eigen::VectorXd standard_parameters() const;
+
+  /// Names `XX1 XY1 ... M1 XX2 ...` matching standard_parameters().
+  std::vector<std::string> standard_parameter_names() const;
+};
+
+/// Parameter names of one link in standard order without the joint index: XX XY XZ YY YZ ZZ MX MY MZ M.
+const std::vector<std::string>& link_parameter_labels();
+
+/// Converts (mass m, centre of mass c in link frame, inertia I_C about the centre of mass with axes
+/// of the link frame) into standard parameters about the link origin (parallel-axis theorem,
+/// seed 1 eq. 24).
+LinkParams link_params_from_com(double m, const Eigen::Vector3d& c, const Eigen::Matrix3d& I_C);
+
+/// The 3×3 inertia about the link origin from standard parameters.
+Eigen::Matrix3d inertia_about_origin(const LinkParams& p);
+
+}  // namespace dynid
