@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 
+#include "dynid/dynamics/rnea.hpp"
 #include "dynid/dynamics/workspace.hpp"
 
 namespace dynid {

@@ -2,6 +2,7 @@
 
 #include <vector>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 
 #include "dynid/model/model.hpp"
@@ -27,9 +28,14 @@ struct LinkState {
 struct Workspace {
   explicit Workspace(const Model& model);
   std::vector<LinkState> links;
-  Eigen::MatrixXd scratch_nn;   ///< n×n scratch (mass matrix, factorisations)
-  Eigen::VectorXd scratch_n;    ///< n scratch
-  Eigen::VectorXd scratch_n2;   ///< n scratch
+  std::vector<std::vector<int>> ancestors;  ///< ancestors[j]: j, parent(j), …, up to the root joint
+  /// twists[j][k]: unit twist (ω; v at origin j) of joint ancestors[j][k], expressed in frame j.
+  std::vector<std::vector<Eigen::Matrix<double, 6, 1>>> twists;
+  std::vector<Eigen::Matrix<double, 6, 6>> composite;  ///< composite spatial inertias (CRBA)
+  Eigen::MatrixXd scratch_nn;             ///< n×n scratch (mass matrix)
+  Eigen::VectorXd scratch_n;              ///< n scratch
+  Eigen::VectorXd scratch_n2;             ///< n scratch
+  Eigen::LLT<Eigen::MatrixXd> llt;        ///< factorisation reused by forward dynamics
 };
 
 }  // namespace dynid

@@ -1,0 +1,61 @@
+#include "dynid/regressor/parameter_layout.hpp"
+
+namespace dynid {
+
+ParameterLayout ParameterLayout::full() {
+  ParameterLayout l;
+  l.armature = l.viscous = l.coulomb = l.offset = true;
+  return l;
+}
+
+int ParameterLayout::joint_columns() const {
+  const int friction_cols = (viscous ? 1 : 0) + (coulomb ? 1 : 0);
+  return (armature ? 1 : 0) + (asymmetric ? 2 * friction_cols : friction_cols) + (offset ? 1 : 0);
+}
+
+std::vector<std::string> ParameterLayout::names(int dof) const {
+  std::vector<std::string> out;
+  out.reserve(columns(dof));
+  for (int j = 0; j < dof; ++j) {
+    for (const auto& label : link_parameter_labels()) out.push_back(label + std::to_string(j + 1));
+  }
+  for (int j = 0; j < dof; ++j) {
+    const std::string k = std::to_string(j + 1);
+    if (armature) out.push_back("Ia" + k);
+    if (asymmetric) {
+      if (viscous) {
+        out.push_back("Fvp" + k);
+        out.push_back("Fvn" + k);
+      }
+      if (coulomb) {
+        out.push_back("Fcp" + k);
+        out.push_back("Fcn" + k);
+      }
+    } else {
+      if (viscous) out.push_back("Fv" + k);
+      if (coulomb) out.push_back("Fc" + k);
+    }
+    if (offset) out.push_back("Fo" + k);
+  }
+  return out;
+}
+
+Eigen::VectorXd ParameterLayout::parameters(const Model& model) const {
+  const int n = model.dof();
+  Eigen::VectorXd theta(columns(n));
+  theta.head(kLinkParams * n) = model.standard_parameters();
+  int c = kLinkParams * n;
+  for (int j = 0; j < n; ++j) {
+    const JointFriction& f = model.joints[j].friction;
+    if (armature) theta[c++] = f.Ia;
+    const int repeat = asymmetric ? 2 : 1;
+    if (viscous)
+      for (int r = 0; r < repeat; ++r) theta[c++] = f.Fv;
+    if (coulomb)
+      for (int r = 0; r < repeat; ++r) theta[c++] = f.Fc;
+    if (offset) theta[c++] = f.Fo;
+  }
+  return theta;
+}
+
+}  // namespace dynid
