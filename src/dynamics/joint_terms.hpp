@@ -5,7 +5,9 @@
 namespace dynid::detail {
 
 /// sign(x) with sign(0) = 0, the Coulomb convention of seed 1 eq. 3 and seed 2 eq. 2.
-inline double sign(double x) { return static_cast<double>((x > 0.0) - (x < 0.0)); }
+inline double sign(double x) {
+  return static_cast<double>((x > 0.0) - (x < 0.0));
+}
 
 /// Joint-side actuator and friction torque Ia·ddq + Fv·dq + Fc·sign(dq) + Fo (seed 1 eq. 3).
 inline double joint_torque(const JointFriction& f, double dq, double ddq) {

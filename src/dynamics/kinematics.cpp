@@ -41,7 +41,8 @@ void forward_kinematics(const Model& model, Workspace& ws,
                         const Eigen::Ref<const Eigen::VectorXd>& dq,
                         const Eigen::Ref<const Eigen::VectorXd>& ddq, bool with_gravity) {
   forward_kinematics(model, ws, q);
-  const Eigen::Vector3d a0 = with_gravity ? Eigen::Vector3d(-model.gravity) : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d a0 =
+      with_gravity ? Eigen::Vector3d(-model.gravity) : Eigen::Vector3d::Zero();
   for (int j = 0; j < model.dof(); ++j) {
     const Joint& joint = model.joints[j];
     LinkState& s = ws.links[j];

@@ -2,8 +2,8 @@
 
 #include <cassert>
 
-#include "dynid/dynamics/kinematics.hpp"
 #include "dynamics/joint_terms.hpp"
+#include "dynid/dynamics/kinematics.hpp"
 
 namespace dynid {
 

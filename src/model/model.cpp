@@ -37,7 +37,9 @@ LinkParams link_params_from_com(double m, const Eigen::Vector3d& c, const Eigen:
 
 namespace {
 
-bool all_finite(const Eigen::Ref<const Eigen::MatrixXd>& m) { return m.allFinite(); }
+bool all_finite(const Eigen::Ref<const Eigen::MatrixXd>& m) {
+  return m.allFinite();
+}
 
 void check_physical(const LinkParams& p, const std::string& link) {
   const double m = p(9);
@@ -56,8 +58,8 @@ void check_physical(const LinkParams& p, const std::string& link) {
   const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(I_C).eigenvalues();
   const double scale = std::max(1.0, ev.cwiseAbs().maxCoeff());
   const double tol = 1e-9 * scale;
-  const bool triangle = ev(0) + ev(1) >= ev(2) - tol && ev(0) + ev(2) >= ev(1) - tol &&
-                        ev(1) + ev(2) >= ev(0) - tol;
+  const bool triangle =
+      ev(0) + ev(1) >= ev(2) - tol && ev(0) + ev(2) >= ev(1) - tol && ev(1) + ev(2) >= ev(0) - tol;
   if (ev.minCoeff() < -tol || !triangle) {
     std::ostringstream msg;
     msg << "link '" << link << "' has a non-physical inertia (principal moments about the centre "
@@ -71,7 +73,8 @@ void check_physical(const LinkParams& p, const std::string& link) {
 
 void Model::finalize() {
   const int n = dof();
-  if (n == 0) throw Error("model '" + name + "' has no moving joints; add a revolute or prismatic joint");
+  if (n == 0)
+    throw Error("model '" + name + "' has no moving joints; add a revolute or prismatic joint");
   if (static_cast<int>(links.size()) != n) {
     throw Error("model '" + name + "' has " + std::to_string(links.size()) +
                 " link parameter sets for " + std::to_string(n) + " joints");
@@ -96,12 +99,14 @@ void Model::finalize() {
     if (!(jt.limits.lower <= jt.limits.upper)) {
       throw Error(who + " has lower limit above upper limit; swap them");
     }
-    if (!links[j].allFinite()) throw Error("link '" + jt.link_name + "' has non-finite inertial values");
+    if (!links[j].allFinite())
+      throw Error("link '" + jt.link_name + "' has non-finite inertial values");
     check_physical(links[j], jt.link_name.empty() ? jt.name : jt.link_name);
   }
   if (transmission.N.size() == 0) transmission.N = Eigen::MatrixXd::Identity(n, n);
   if (transmission.q_offset.size() == 0) transmission.q_offset = Eigen::VectorXd::Zero(n);
-  if (transmission.N.rows() != n || transmission.N.cols() != n || transmission.q_offset.size() != n) {
+  if (transmission.N.rows() != n || transmission.N.cols() != n ||
+      transmission.q_offset.size() != n) {
     throw Error("model '" + name + "' has a transmission of the wrong size; it must be " +
                 std::to_string(n) + "x" + std::to_string(n));
   }
@@ -120,7 +125,8 @@ std::vector<std::string> Model::standard_parameter_names() const {
   std::vector<std::string> names;
   names.reserve(kLinkParams * dof());
   for (int j = 0; j < dof(); ++j) {
-    for (const auto& label : link_parameter_labels()) names.push_back(label + std::to_string(j + 1));
+    for (const auto& label : link_parameter_labels())
+      names.push_back(label + std::to_string(j + 1));
   }
   return names;
 }

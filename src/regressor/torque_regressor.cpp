@@ -47,8 +47,7 @@ void torque_regressor(const Model& model, Workspace& ws, const ParameterLayout& 
   const int jc = layout.joint_columns();
   if (jc == 0) return;
   for (int j = 0; j < n; ++j) {
-    detail::joint_columns(layout, dq[j], ddq[j],
-                          Y.row(j).segment(kLinkParams * n + jc * j, jc));
+    detail::joint_columns(layout, dq[j], ddq[j], Y.row(j).segment(kLinkParams * n + jc * j, jc));
   }
 }
 

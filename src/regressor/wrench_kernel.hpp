@@ -20,10 +20,10 @@ inline Eigen::Matrix<double, 3, 6> dot_matrix(const Eigen::Vector3d& w) {
 /// [XX XY XZ YY YZ ZZ MX MY MZ M]. w, dw: angular velocity/acceleration; a: acceleration of O minus
 /// gravity; all in the body frame.
 struct WrenchBlocks {
-  Eigen::Matrix3d K_mc;                 ///< f = K_mc·mc + a·m, K_mc = [dω×] + [ω×][ω×]
-  Eigen::Matrix<double, 3, 6> L_I;      ///< n = L_I·I + [mc×]a…, L_I = [·dω] + [ω×][·ω]
-  Eigen::Matrix3d A_skew;               ///< n contribution of mc: −[a×]
-  Eigen::Vector3d a;                    ///< f contribution of m
+  Eigen::Matrix3d K_mc;             ///< f = K_mc·mc + a·m, K_mc = [dω×] + [ω×][ω×]
+  Eigen::Matrix<double, 3, 6> L_I;  ///< n = L_I·I + [mc×]a…, L_I = [·dω] + [ω×][·ω]
+  Eigen::Matrix3d A_skew;           ///< n contribution of mc: −[a×]
+  Eigen::Vector3d a;                ///< f contribution of m
 };
 
 inline void wrench_blocks(const Eigen::Vector3d& w, const Eigen::Vector3d& dw,

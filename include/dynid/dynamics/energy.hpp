@@ -11,6 +11,7 @@ double kinetic_energy(const Model& model, Workspace& ws, const Eigen::Ref<const 
                       const Eigen::Ref<const Eigen::VectorXd>& dq);
 
 /// Potential energy E_p = −Σ_j gᵀ(m_j p_WJ + R_WJ·mc_j) [J], zero at the base origin.
-double potential_energy(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q);
+double potential_energy(const Model& model, Workspace& ws,
+                        const Eigen::Ref<const Eigen::VectorXd>& q);
 
 }  // namespace dynid

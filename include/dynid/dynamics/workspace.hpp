@@ -4,6 +4,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "dynid/model/model.hpp"
 
@@ -32,10 +33,10 @@ struct Workspace {
   /// twists[j][k]: unit twist (ω; v at origin j) of joint ancestors[j][k], expressed in frame j.
   std::vector<std::vector<Eigen::Matrix<double, 6, 1>>> twists;
   std::vector<Eigen::Matrix<double, 6, 6>> composite;  ///< composite spatial inertias (CRBA)
-  Eigen::MatrixXd scratch_nn;             ///< n×n scratch (mass matrix)
-  Eigen::VectorXd scratch_n;              ///< n scratch
-  Eigen::VectorXd scratch_n2;             ///< n scratch
-  Eigen::LLT<Eigen::MatrixXd> llt;        ///< factorisation reused by forward dynamics
+  Eigen::MatrixXd scratch_nn;                          ///< n×n scratch (mass matrix)
+  Eigen::VectorXd scratch_n;                           ///< n scratch
+  Eigen::VectorXd scratch_n2;                          ///< n scratch
+  Eigen::LLT<Eigen::MatrixXd> llt;                     ///< factorisation reused by forward dynamics
 };
 
 }  // namespace dynid

@@ -28,16 +28,16 @@ struct JointFriction {
 
 /// Joint limits; absent limits are +/- infinity.
 struct JointLimits {
-  double lower = -std::numeric_limits<double>::infinity();     ///< [rad or m]
-  double upper = std::numeric_limits<double>::infinity();      ///< [rad or m]
-  double velocity = std::numeric_limits<double>::infinity();   ///< [rad/s or m/s]
-  double effort = std::numeric_limits<double>::infinity();     ///< [N·m or N]
+  double lower = -std::numeric_limits<double>::infinity();    ///< [rad or m]
+  double upper = std::numeric_limits<double>::infinity();     ///< [rad or m]
+  double velocity = std::numeric_limits<double>::infinity();  ///< [rad/s or m/s]
+  double effort = std::numeric_limits<double>::infinity();    ///< [N·m or N]
 };
 
 /// Joint j connects link parent (-1 = the fixed base) to link j. Frame convention (URDF): the pose
 /// of link frame j in its parent's frame is X_PJ(q) = (R_PJ, p_PJ) · motion(axis, q), where the
-/// motion is a rotation by q about `axis` (revolute) or a translation q·axis (prismatic), axis given
-/// in frame j. Modified DH rows map onto the same form (docs/notation.md).
+/// motion is a rotation by q about `axis` (revolute) or a translation q·axis (prismatic), axis
+/// given in frame j. Modified DH rows map onto the same form (docs/notation.md).
 struct Joint {
   std::string name;
   std::string link_name;
@@ -53,8 +53,8 @@ struct Joint {
 /// Motor <-> joint transmission (DESIGN.md section 3): q_motor = N·(q - q_offset), so
 /// q = N⁻¹·q_motor + q_offset, and tau_joint = Nᵀ·tau_motor. N is n×n, identity by default.
 struct Transmission {
-  Eigen::MatrixXd N;          ///< n×n, invertible
-  Eigen::VectorXd q_offset;   ///< n, added to the joint angles after N⁻¹ [rad or m]
+  Eigen::MatrixXd N;         ///< n×n, invertible
+  Eigen::VectorXd q_offset;  ///< n, added to the joint angles after N⁻¹ [rad or m]
   bool is_identity() const;
 };
 
@@ -64,10 +64,10 @@ struct Transmission {
 struct Model {
   std::string name;
   std::vector<Joint> joints;
-  std::vector<LinkParams> links;                       ///< one per joint, standard order
-  Eigen::Vector3d gravity{0.0, 0.0, -9.81};            ///< in the base frame [m/s²]
+  std::vector<LinkParams> links;             ///< one per joint, standard order
+  Eigen::Vector3d gravity{0.0, 0.0, -9.81};  ///< in the base frame [m/s²]
   Transmission transmission;
-  std::string source;                                  ///< file or built-in name it came from
+  std::string source;  ///< file or built-in name it came from
 
   int dof() const { return static_cast<int>(joints.size()); }
 
@@ -84,7 +84,8 @@ struct Model {
   std::vector<std::string> standard_parameter_names() const;
 };
 
-/// Parameter names of one link in standard order without the joint index: XX XY XZ YY YZ ZZ MX MY MZ M.
+/// Parameter names of one link in standard order without the joint index: XX XY XZ YY YZ ZZ MX MY
+/// MZ M.
 const std::vector<std::string>& link_parameter_labels();
 
 /// Converts (mass m, centre of mass c in link frame, inertia I_C about the centre of mass with axes
