@@ -1,0 +1,67 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "dynid/model/model.hpp"
+#include "dynid/regressor/parameter_layout.hpp"
+
+namespace dynid {
+
+/// Which regressor is sampled to find the base parameters.
+enum class BaseRegressor {
+  kTorque,  ///< the differential model Y(q, dq, ddq) (seed 1 eq. 5)
+  kEnergy,  ///< differences of the energy row h(q, dq) (seed 2 eqs. 4–8); friction columns have
+            ///< no energy, so only the link and armature columns are classified from it
+};
+
+/// Options of the numerical base-parameter computation.
+struct BaseParameterOptions {
+  ParameterLayout layout;  ///< columns to classify (link + per-joint terms)
+  BaseRegressor regressor = BaseRegressor::kTorque;  ///< which model is sampled
+  int samples = 0;           ///< random states; 0 = max(100, 4·columns/n) (enough for full rank)
+  unsigned seed = 20261123;  ///< fixed seed: the same model gives the same base set every time
+  double zero_tolerance = 1e-10;       ///< column norm / largest column norm below this: no effect
+  double dependence_tolerance = 1e-8;  ///< residual / own norm below this: linearly dependent
+  double coefficient_digits = 6;       ///< significant digits of K_d in the expressions
+};
+
+/// The base (identifiable) parameters: theta_b = theta_1 + K_d·theta_2 (Gautier–Khalil 1990).
+struct BaseParameters {
+  int rank = 0;                           ///< number of base parameters
+  std::vector<int> base;                  ///< indices (into the layout) of theta_1, increasing
+  std::vector<int> dependent;             ///< indices of theta_2 (regrouped into the base ones)
+  std::vector<int> unidentifiable;        ///< indices with no effect at all (seed 2 eq. 6)
+  Eigen::MatrixXd K_d;                    ///< base.size() × dependent.size()
+  std::vector<std::string> names;         ///< base parameter names, `R` suffix when regrouped
+  std::vector<std::string> expressions;   ///< `ZZ2R = ZZ2 + 0.2025*M3 + YY3`
+  std::vector<std::string> layout_names;  ///< names of every layout column
+  int samples = 0;                        ///< random states used
+
+  /// theta_b = theta_1 + K_d·theta_2 for a full layout vector theta.
+  Eigen::VectorXd reduce(const Eigen::Ref<const Eigen::VectorXd>& theta) const;
+  /// The base regressor W_b = W_1 + 0 (the base columns of W): since W_2 = W_1·K_d, W·theta =
+  /// W_b·theta_b.
+  Eigen::MatrixXd select(const Eigen::Ref<const Eigen::MatrixXd>& W) const;
+  /// Names of the standard parameters that have no effect (unidentifiable).
+  std::vector<std::string> unidentifiable_names() const;
+};
+
+/// Numerical base parameters (Gautier 1990, "Numerical calculation of the base inertial parameters
+/// of robots"): sample the regressor at random states, keep the columns that are independent of the
+/// columns before them (a left-to-right rank-revealing sweep, so each base parameter is named after
+/// the earliest standard parameter it contains, as in Khalil's regrouping rules), and solve
+/// W_2 = W_1·K_d by least squares. Deterministic for a given model and options.
+/// Throws dynid::Error if the model has no identifiable parameter.
+BaseParameters compute_base_parameters(const Model& model,
+                                       const BaseParameterOptions& options = {});
+
+/// Classifies the columns of a given sampled regressor W (rows = equations) the same way; used by
+/// compute_base_parameters and by the identification on real data to report unexcited columns.
+BaseParameters classify_columns(const Eigen::Ref<const Eigen::MatrixXd>& W,
+                                const std::vector<std::string>& names,
+                                const BaseParameterOptions& options);
+
+}  // namespace dynid
