@@ -1,0 +1,227 @@
+// Low-pass design and zero-phase filtering against the analytic prototype magnitudes.
+#include <cmath>
+#include <complex>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <Eigen/Dense>
+
+#include "dynid/common/error.hpp"
+#include "dynid/signal/lowpass_design.hpp"
+#include "dynid/signal/zero_phase_filter.hpp"
+
+namespace dynid {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Independent oracle: Chebyshev polynomial T_N(x) by its trigonometric/hyperbolic closed form.
+double chebyshev_t(int n, double x) {
+  if (std::abs(x) <= 1.0) return std::cos(n * std::acos(x));
+  const double v = std::cosh(n * std::acosh(std::abs(x)));
+  return (x < 0 && n % 2 == 1) ? -v : v;
+}
+
+// Independent oracle: |H_a(jΩ)| of the analog prototype at the pre-warped frequency of f.
+double analytic_magnitude(const LowpassOptions& o, double f) {
+  const double r =
+      std::tan(kPi * f / o.sample_rate_hz) / std::tan(kPi * o.cutoff_hz / o.sample_rate_hz);
+  if (o.family == LowpassFamily::kButterworth)
+    return 1.0 / std::sqrt(1.0 + std::pow(r, 2 * o.order));
+  const double eps2 = std::pow(10.0, o.ripple_db / 10.0) - 1.0;
+  const double t = chebyshev_t(o.order, r);
+  return 1.0 / std::sqrt(1.0 + eps2 * t * t);
+}
+
+// Least-squares fit y ≈ A·sin(ωt) + B·cos(ωt) on rows [begin, end): returns (A, B).
+Eigen::Vector2d fit_sine(const Eigen::VectorXd& y, double w, Eigen::Index begin, Eigen::Index end) {
+  Eigen::MatrixXd phi(end - begin, 2);
+  for (Eigen::Index k = begin; k < end; ++k) {
+    phi(k - begin, 0) = std::sin(w * k);
+    phi(k - begin, 1) = std::cos(w * k);
+  }
+  return phi.colPivHouseholderQr().solve(y.segment(begin, end - begin));
+}
+
+struct DesignCase {
+  LowpassFamily family;
+  int order;
+  double cutoff, rate, ripple;
+};
+
+class LowpassDesignTest : public ::testing::TestWithParam<DesignCase> {};
+
+// The designed sections reproduce |H_a(j·2fs·tan(ω/2))| (bilinear transform with pre-warping).
+TEST_P(LowpassDesignTest, FrequencyResponseMatchesAnalyticPrototype) {
+  const DesignCase c = GetParam();
+  LowpassOptions o;
+  o.family = c.family;
+  o.order = c.order;
+  o.cutoff_hz = c.cutoff;
+  o.sample_rate_hz = c.rate;
+  o.ripple_db = c.ripple;
+  const SosFilter f = design_lowpass(o);
+  EXPECT_EQ(f.order(), c.order);
+  EXPECT_EQ(f.sections(), (c.order + 1) / 2);
+  for (double ratio : {0.0, 0.1, 0.3, 0.5, 0.77, 0.95, 1.0, 1.05, 1.3, 2.0, 3.0}) {
+    const double fr = ratio * c.cutoff;
+    if (fr >= 0.5 * c.rate) continue;
+    const double expected = analytic_magnitude(o, fr);
+    const double got = std::abs(frequency_response(f, fr, c.rate));
+    EXPECT_NEAR(got, expected, 1e-9 * std::max(expected, 1e-3)) << "f = " << fr << " Hz";
+  }
+  // Stable: every section's poles strictly inside the unit circle (|a2| < 1, |a1| < 1 + a2).
+  for (int s = 0; s < f.sections(); ++s) {
+    EXPECT_LT(std::abs(f.sos(s, 5)), 1.0);
+    EXPECT_LT(std::abs(f.sos(s, 4)), 1.0 + f.sos(s, 5));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Designs, LowpassDesignTest,
+    ::testing::Values(DesignCase{LowpassFamily::kButterworth, 1, 50, 1000, 0},
+                      DesignCase{LowpassFamily::kButterworth, 2, 50, 1000, 0},
+                      DesignCase{LowpassFamily::kButterworth, 5, 120, 1000, 0},
+                      DesignCase{LowpassFamily::kButterworth, 8, 80, 5000, 0},
+                      DesignCase{LowpassFamily::kChebyshev1, 3, 40, 1000, 1.0},
+                      DesignCase{LowpassFamily::kChebyshev1, 4, 100, 1000, 0.5},
+                      DesignCase{LowpassFamily::kChebyshev1, 8, 80, 1000, 0.5},
+                      DesignCase{LowpassFamily::kChebyshev1, 8, 80, 5000, 0.05},
+                      DesignCase{LowpassFamily::kChebyshev1, 7, 300, 1000, 0.1}));
+
+// Filtering sinusoids (steady state, middle of a long record) with filtfilt gives the squared
+// analytic magnitude and no phase lag: the measured response, not the formula, of the code.
+TEST(Filtfilt, SineSteadyStateIsSquaredMagnitudeWithZeroPhase) {
+  for (double rate : {1000.0, 5000.0}) {
+    for (LowpassFamily fam : {LowpassFamily::kButterworth, LowpassFamily::kChebyshev1}) {
+      LowpassOptions o;
+      o.family = fam;
+      o.order = 8;
+      o.cutoff_hz = 80.0;
+      o.sample_rate_hz = rate;
+      o.ripple_db = 0.5;
+      const SosFilter f = design_lowpass(o);
+      const Eigen::Index m = rate > 2000 ? 40000 : 12000;
+      for (double fr : {5.0, 40.0, 70.0, 80.0, 90.0, 110.0}) {
+        const double w = 2.0 * kPi * fr / rate;
+        Eigen::VectorXd x(m);
+        for (Eigen::Index k = 0; k < m; ++k) x(k) = std::sin(w * k);
+        const Eigen::VectorXd y = filtfilt(f, x);
+        const Eigen::Vector2d ab = fit_sine(y, w, m / 3, 2 * m / 3);
+        const double h = analytic_magnitude(o, fr);
+        const std::string where = "rate " + std::to_string(rate) + " f " + std::to_string(fr);
+        EXPECT_NEAR(ab.norm(), h * h, 1e-7 + 1e-6 * h * h) << where;
+        EXPECT_NEAR(std::atan2(ab(1), ab(0)), 0.0, 1e-6) << where;  // zero phase
+      }
+    }
+  }
+}
+
+// A causal pass lags: its phase equals arg H(e^{jω}) (independent check of sosfilt against the
+// section product), while filtfilt applied to columns treats each column independently.
+TEST(Sosfilt, CausalPhaseMatchesResponseAndColumnsAreIndependent) {
+  LowpassOptions o;
+  o.family = LowpassFamily::kChebyshev1;
+  o.order = 5;
+  o.cutoff_hz = 30;
+  o.sample_rate_hz = 1000;
+  const SosFilter f = design_lowpass(o);
+  const double fr = 20.0, w = 2.0 * kPi * fr / 1000.0;
+  const Eigen::Index m = 6000;
+  Eigen::MatrixXd x(m, 2);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    x(k, 0) = std::sin(w * k);
+    x(k, 1) = 3.0 - 2.0 * std::cos(0.3 * k);
+  }
+  const Eigen::MatrixXd y = sosfilt(f, x);
+  const Eigen::Vector2d ab = fit_sine(y.col(0), w, 3000, 6000);
+  const std::complex<double> h = frequency_response(f, fr, 1000.0);
+  EXPECT_NEAR(ab(0), h.real(), 1e-9);  // y = |H| sin(ωk + φ) = Re H sin + Im H cos
+  EXPECT_NEAR(ab(1), h.imag(), 1e-9);
+  const Eigen::MatrixXd yy = filtfilt(f, x);
+  EXPECT_TRUE(yy.col(1).isApprox(filtfilt(f, Eigen::VectorXd(x.col(1))), 1e-15));
+}
+
+// Steady-state initial conditions: a constant signal passes unchanged, at every sample.
+TEST(Filtfilt, ConstantAndStepSteadyState) {
+  LowpassOptions o;
+  o.family = LowpassFamily::kChebyshev1;
+  o.order = 8;
+  o.cutoff_hz = 80;
+  o.sample_rate_hz = 1000;
+  const SosFilter f = design_lowpass(o);
+  const Eigen::MatrixXd x = Eigen::MatrixXd::Constant(200, 3, 2.5);
+  // Chebyshev with even order has DC gain 1/sqrt(1+ε²) per pass.
+  const double eps2 = std::pow(10.0, 0.5 / 10.0) - 1.0;
+  EXPECT_NEAR((filtfilt(f, x).array() - 2.5 / (1.0 + eps2)).abs().maxCoeff(), 0.0, 1e-12);
+  const Eigen::MatrixXd zi = sosfilt_steady_state(f);
+  const Eigen::MatrixXd yc = sosfilt(f, x, zi);
+  EXPECT_NEAR((yc.array() - 2.5 / std::sqrt(1.0 + eps2)).abs().maxCoeff(), 0.0, 1e-12);
+  // A line is reproduced by odd reflection + steady state only approximately; a Butterworth
+  // filtfilt of a ramp has zero phase, so the interior equals the ramp (DC gain 1, no lag).
+  o.family = LowpassFamily::kButterworth;
+  const SosFilter b = design_lowpass(o);
+  Eigen::VectorXd ramp = Eigen::VectorXd::LinSpaced(3000, -1.0, 2.0);
+  const Eigen::VectorXd yr = filtfilt(b, ramp);
+  EXPECT_LT((yr - ramp).segment(500, 2000).cwiseAbs().maxCoeff(), 1e-9);
+}
+
+TEST(LowpassErrors, MessagesNameInputAndFix) {
+  auto expect_error = [](const LowpassOptions& o, const std::string& text) {
+    try {
+      design_lowpass(o);
+      ADD_FAILURE() << "no error for " << text;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+    }
+  };
+  LowpassOptions o;
+  o.cutoff_hz = 500;
+  o.sample_rate_hz = 1000;
+  expect_error(o,
+               "low-pass cut-off 500 Hz is outside (0, Nyquist = 500 Hz) for sample rate 1000 "
+               "Hz: lower the cut-off or use data sampled faster");
+  o.cutoff_hz = 80;
+  o.order = 0;
+  expect_error(o, "low-pass filter order is 0: give an order of at least 1");
+  o.order = 4;
+  o.sample_rate_hz = -1;
+  expect_error(o,
+               "low-pass filter sample rate is -1 Hz: give the positive sample rate of the data");
+  o.sample_rate_hz = 1000;
+  o.family = LowpassFamily::kChebyshev1;
+  o.ripple_db = 0;
+  expect_error(o, "Chebyshev passband ripple is 0 dB: give a positive ripple (e.g. 0.5 dB)");
+
+  o.ripple_db = 0.5;
+  o.order = 8;
+  const SosFilter f = design_lowpass(o);
+  EXPECT_EQ(filtfilt_default_padding(f), 27);
+  try {
+    filtfilt(f, Eigen::VectorXd::Zero(27));
+    ADD_FAILURE();
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(),
+                 "zero-phase filter input has 27 samples but the order-8 filter pads 27 samples "
+                 "per end: give at least 28 samples or lower the filter order");
+  }
+  Eigen::VectorXd bad = Eigen::VectorXd::Zero(100);
+  bad(5) = std::nan("");
+  try {
+    filtfilt(f, bad);
+    ADD_FAILURE();
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(),
+                 "zero-phase filter input contains NaN or Inf: clean or drop those samples first");
+  }
+  try {
+    sosfilt(f, bad, Eigen::MatrixXd::Zero(3, 2));
+    ADD_FAILURE();
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(),
+                 "sosfilt initial state is 3x2: give sections x 2 (4x2) or an empty matrix");
+  }
+}
+
+}  // namespace
+}  // namespace dynid
