@@ -1,0 +1,27 @@
+#pragma once
+
+#include <string>
+
+#include "dynid/model/model.hpp"
+
+namespace dynid {
+
+/// Options of the URDF export.
+struct UrdfWriteOptions {
+  std::string root_link = "base_link";  ///< name of the fixed root link
+  bool mujoco_compiler_tag = false;  ///< add <mujoco><compiler …/></mujoco> so MuJoCo keeps every
+                                     ///< body and inertia exactly as written
+};
+
+/// Writes the model as URDF text: one joint per Model joint (revolute with ±inf limits becomes
+/// continuous), origins as xyz/rpy, inertials about the centre of mass with the full tensor in the
+/// link frame (standard parameters converted back by the parallel-axis theorem), <dynamics damping
+/// friction> from Fv and Fc. Links with zero mass get a tiny placeholder inertia-free <inertial>.
+/// Round trip: load_urdf(to_urdf(model)) reproduces the dynamics (the loader merges nothing).
+std::string to_urdf(const Model& model, const UrdfWriteOptions& options = {});
+
+/// to_urdf written atomically to `path` (temporary file, then rename). Throws dynid::Error when the
+/// file cannot be written.
+void write_urdf(const Model& model, const std::string& path, const UrdfWriteOptions& options = {});
+
+}  // namespace dynid

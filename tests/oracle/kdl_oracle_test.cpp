@@ -1,0 +1,94 @@
+// RNEA against Orocos KDL's TreeIdSolver_RNE / ChainIdSolver_RNE on the same URDF text.
+#include <map>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <kdl/chainidsolver_recursive_newton_euler.hpp>
+#include <kdl/tree.hpp>
+#include <kdl/treeidsolver_recursive_newton_euler.hpp>
+#include <kdl_parser/kdl_parser.hpp>
+
+#include "dynid/dynamics/rnea.hpp"
+#include "dynid/io/urdf_writer.hpp"
+#include "oracle/oracle_support.hpp"
+#include "support/random_models.hpp"
+
+namespace dynid {
+namespace {
+
+using testing::random_tree;
+using testing::random_vector;
+
+// Index of each KDL tree joint (q_nr) in dynid's joint order, matched by joint name.
+std::vector<unsigned> kdl_indices(const KDL::Tree& tree, const Model& model) {
+  std::map<std::string, unsigned> by_name;
+  for (const auto& [name, element] : tree.getSegments()) {
+    const KDL::Joint& joint = element.segment.getJoint();
+    if (joint.getType() != KDL::Joint::None) by_name[joint.getName()] = GetTreeElementQNr(element);
+  }
+  std::vector<unsigned> out;
+  for (const Joint& j : model.joints) out.push_back(by_name.at(j.name));
+  return out;
+}
+
+class KdlTreeOracle : public ::testing::TestWithParam<unsigned> {};
+
+TEST_P(KdlTreeOracle, RneaMatchesTreeIdSolver) {
+  const unsigned seed = GetParam();
+  Model model = random_tree(8, seed, true, false);
+  for (auto& j : model.joints) j.friction = {};  // KDL has no joint friction or armature
+  KDL::Tree tree;
+  ASSERT_TRUE(kdl_parser::treeFromString(to_urdf(model), tree));
+  ASSERT_EQ(tree.getNrOfJoints(), 8u);
+  const std::vector<unsigned> idx = kdl_indices(tree, model);
+  KDL::TreeIdSolver_RNE solver(
+      tree, KDL::Vector(model.gravity.x(), model.gravity.y(), model.gravity.z()));
+  Workspace ws(model);
+  std::mt19937 rng(seed);
+  for (int k = 0; k < 20; ++k) {
+    const Eigen::VectorXd q = random_vector(8, rng, 3.0), dq = random_vector(8, rng, 2.0),
+                          ddq = random_vector(8, rng, 5.0);
+    KDL::JntArray kq(8), kdq(8), kddq(8), ktau(8);
+    for (int j = 0; j < 8; ++j) {
+      kq(idx[j]) = q[j];
+      kdq(idx[j]) = dq[j];
+      kddq(idx[j]) = ddq[j];
+    }
+    ASSERT_GE(solver.CartToJnt(kq, kdq, kddq, KDL::WrenchMap(), ktau), 0);
+    Eigen::VectorXd tau(8), tau_kdl(8);
+    rnea(model, ws, q, dq, ddq, tau);
+    for (int j = 0; j < 8; ++j) tau_kdl[j] = ktau(idx[j]);
+    EXPECT_LT((tau - tau_kdl).norm() / tau_kdl.norm(), testing::kOracleTolerance) << "state " << k;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(RandomTrees, KdlTreeOracle, ::testing::Values(1u, 2u, 3u, 4u));
+
+TEST(KdlChainOracle, RneaMatchesChainIdSolver) {
+  Model model = random_tree(7, 77, true, true);
+  for (auto& j : model.joints) j.friction = {};
+  KDL::Tree tree;
+  ASSERT_TRUE(kdl_parser::treeFromString(to_urdf(model), tree));
+  KDL::Chain chain;
+  ASSERT_TRUE(tree.getChain("base_link", model.joints.back().link_name, chain));
+  KDL::ChainIdSolver_RNE solver(
+      chain, KDL::Vector(model.gravity.x(), model.gravity.y(), model.gravity.z()));
+  Workspace ws(model);
+  std::mt19937 rng(77);
+  for (int k = 0; k < 20; ++k) {
+    const Eigen::VectorXd q = random_vector(7, rng, 3.0), dq = random_vector(7, rng, 2.0),
+                          ddq = random_vector(7, rng, 5.0);
+    KDL::JntArray kq(7), kdq(7), kddq(7), ktau(7);
+    kq.data = q;
+    kdq.data = dq;
+    kddq.data = ddq;
+    KDL::Wrenches f_ext(chain.getNrOfSegments(), KDL::Wrench::Zero());
+    ASSERT_GE(solver.CartToJnt(kq, kdq, kddq, f_ext, ktau), 0);
+    Eigen::VectorXd tau(7);
+    rnea(model, ws, q, dq, ddq, tau);
+    EXPECT_LT((tau - ktau.data).norm() / ktau.data.norm(), testing::kOracleTolerance);
+  }
+}
+
+}  // namespace
+}  // namespace dynid

@@ -1,0 +1,82 @@
+// RNEA (with armature and viscous friction) against MuJoCo's mj_inverse on the same URDF text.
+#include <cstdio>
+#include <fstream>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
+#include "dynid/dynamics/rnea.hpp"
+#include "dynid/io/urdf_writer.hpp"
+#include "oracle/oracle_support.hpp"
+#include "support/random_models.hpp"
+
+namespace dynid {
+namespace {
+
+using testing::random_tree;
+using testing::random_vector;
+
+struct MujocoModel {
+  mjModel* m = nullptr;
+  mjData* d = nullptr;
+  ~MujocoModel() {
+    if (d) mj_deleteData(d);
+    if (m) mj_deleteModel(m);
+  }
+};
+
+void load(const Model& model, MujocoModel& out) {
+  UrdfWriteOptions options;
+  options.mujoco_compiler_tag = true;
+  const std::string path = ::testing::TempDir() + "/mujoco_oracle_" + model.name + ".urdf";
+  std::ofstream(path) << to_urdf(model, options);
+  char error[1000] = "";
+  out.m = mj_loadXML(path.c_str(), nullptr, error, sizeof(error));
+  std::remove(path.c_str());
+  ASSERT_NE(out.m, nullptr) << error;
+  out.d = mj_makeData(out.m);
+  for (int k = 0; k < 3; ++k) out.m->opt.gravity[k] = model.gravity[k];
+  out.m->opt.disableflags |= mjDSBL_CONSTRAINT;  // joint limits must not act in this comparison
+}
+
+class MujocoOracle : public ::testing::TestWithParam<unsigned> {};
+
+TEST_P(MujocoOracle, RneaMatchesMjInverse) {
+  const unsigned seed = GetParam();
+  Model model = random_tree(8, seed, true, seed % 2 == 0);
+  for (auto& j : model.joints) j.friction.Fc = j.friction.Fo = 0.0;  // not plain mj_inverse terms
+  MujocoModel mj;
+  load(model, mj);
+  ASSERT_EQ(mj.m->nv, 8);
+  std::vector<int> dof(8);
+  for (int j = 0; j < 8; ++j) {
+    const int id = mj_name2id(mj.m, mjOBJ_JOINT, model.joints[j].name.c_str());
+    ASSERT_GE(id, 0) << model.joints[j].name;
+    dof[j] = mj.m->jnt_dofadr[id];
+    ASSERT_EQ(mj.m->jnt_qposadr[id], dof[j]);  // hinge and slide joints only
+    mj.m->dof_armature[dof[j]] = model.joints[j].friction.Ia;
+    EXPECT_NEAR(mj.m->dof_damping[dof[j]], model.joints[j].friction.Fv, 1e-15);
+  }
+  Workspace ws(model);
+  std::mt19937 rng(seed);
+  for (int k = 0; k < 20; ++k) {
+    const Eigen::VectorXd q = random_vector(8, rng, 3.0), dq = random_vector(8, rng, 2.0),
+                          ddq = random_vector(8, rng, 5.0);
+    for (int j = 0; j < 8; ++j) {
+      mj.d->qpos[dof[j]] = q[j];
+      mj.d->qvel[dof[j]] = dq[j];
+      mj.d->qacc[dof[j]] = ddq[j];
+    }
+    mj_inverse(mj.m, mj.d);
+    Eigen::VectorXd tau(8), tau_mj(8);
+    rnea(model, ws, q, dq, ddq, tau);
+    for (int j = 0; j < 8; ++j) tau_mj[j] = mj.d->qfrc_inverse[dof[j]];
+    EXPECT_LT((tau - tau_mj).norm() / tau_mj.norm(), testing::kOracleTolerance) << "state " << k;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(RandomTrees, MujocoOracle, ::testing::Values(1u, 2u, 3u, 4u));
+
+}  // namespace
+}  // namespace dynid
