@@ -1,0 +1,135 @@
+// RNEA, mass matrix, torque and energy regressors of dynid against KDL's ChainIdSolver_RNE on the
+// same robot (the KDL chain is parsed from dynid's URDF export of the built-in model).
+// Run: ./build/bench/dynamics_bench --benchmark_repetitions=5
+// --benchmark_report_aggregates_only=true
+#include <random>
+
+#include <benchmark/benchmark.h>
+#include <kdl/chainidsolver_recursive_newton_euler.hpp>
+#include <kdl/tree.hpp>
+#include <kdl_parser/kdl_parser.hpp>
+
+#include "dynid/dynamics/mass_matrix.hpp"
+#include "dynid/dynamics/rnea.hpp"
+#include "dynid/io/urdf_writer.hpp"
+#include "dynid/model/robots.hpp"
+#include "dynid/regressor/energy_regressor.hpp"
+#include "dynid/regressor/torque_regressor.hpp"
+
+namespace {
+
+using dynid::Model;
+
+struct State {
+  Eigen::VectorXd q, dq, ddq;
+  explicit State(int n) {
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    q = Eigen::VectorXd::NullaryExpr(n, [&] { return u(rng); });
+    dq = Eigen::VectorXd::NullaryExpr(n, [&] { return u(rng); });
+    ddq = Eigen::VectorXd::NullaryExpr(n, [&] { return u(rng); });
+  }
+};
+
+const Model& robot(const std::string& name) {
+  static std::map<std::string, Model> cache;
+  auto it = cache.find(name);
+  if (it == cache.end()) it = cache.emplace(name, dynid::load_robot(name)).first;
+  return it->second;
+}
+
+void BM_Rnea(benchmark::State& st, const std::string& name) {
+  const Model& model = robot(name);
+  dynid::Workspace ws(model);
+  const State s(model.dof());
+  Eigen::VectorXd tau(model.dof());
+  for (auto _ : st) {
+    dynid::rnea(model, ws, s.q, s.dq, s.ddq, tau);
+    benchmark::DoNotOptimize(tau.data());
+  }
+}
+
+void BM_RneaRigid(benchmark::State& st, const std::string& name) {
+  const Model& model = robot(name);
+  dynid::Workspace ws(model);
+  const State s(model.dof());
+  Eigen::VectorXd tau(model.dof());
+  for (auto _ : st) {
+    dynid::rnea(model, ws, s.q, s.dq, s.ddq, tau, dynid::RneaOptions{true, false});
+    benchmark::DoNotOptimize(tau.data());
+  }
+}
+
+void BM_MassMatrix(benchmark::State& st, const std::string& name) {
+  const Model& model = robot(name);
+  dynid::Workspace ws(model);
+  const State s(model.dof());
+  Eigen::MatrixXd M(model.dof(), model.dof());
+  for (auto _ : st) {
+    dynid::mass_matrix(model, ws, s.q, M);
+    benchmark::DoNotOptimize(M.data());
+  }
+}
+
+void BM_TorqueRegressor(benchmark::State& st, const std::string& name) {
+  const Model& model = robot(name);
+  dynid::Workspace ws(model);
+  const State s(model.dof());
+  const auto layout = dynid::ParameterLayout::full();
+  Eigen::MatrixXd Y(model.dof(), layout.columns(model.dof()));
+  for (auto _ : st) {
+    dynid::torque_regressor(model, ws, layout, s.q, s.dq, s.ddq, Y);
+    benchmark::DoNotOptimize(Y.data());
+  }
+}
+
+void BM_EnergyRegressor(benchmark::State& st, const std::string& name) {
+  const Model& model = robot(name);
+  dynid::Workspace ws(model);
+  const State s(model.dof());
+  const auto layout = dynid::ParameterLayout::full();
+  Eigen::VectorXd h(layout.columns(model.dof()));
+  for (auto _ : st) {
+    dynid::energy_regressor(model, ws, layout, s.q, s.dq, h);
+    benchmark::DoNotOptimize(h.data());
+  }
+}
+
+void BM_KdlRne(benchmark::State& st, const std::string& name) {
+  Model model = robot(name);
+  KDL::Tree tree;
+  if (!kdl_parser::treeFromString(dynid::to_urdf(model), tree)) {
+    st.SkipWithError("kdl_parser failed");
+    return;
+  }
+  KDL::Chain chain;
+  tree.getChain("base_link", model.joints.back().link_name, chain);
+  KDL::ChainIdSolver_RNE solver(
+      chain, KDL::Vector(model.gravity.x(), model.gravity.y(), model.gravity.z()));
+  const int n = model.dof();
+  const State s(n);
+  KDL::JntArray q(n), dq(n), ddq(n), tau(n);
+  q.data = s.q;
+  dq.data = s.dq;
+  ddq.data = s.ddq;
+  KDL::Wrenches f_ext(chain.getNrOfSegments(), KDL::Wrench::Zero());
+  for (auto _ : st) {
+    solver.CartToJnt(q, dq, ddq, f_ext, tau);
+    benchmark::DoNotOptimize(tau.data.data());
+  }
+}
+
+}  // namespace
+
+#define DYNID_ROBOT_BENCH(robot_name)                             \
+  BENCHMARK_CAPTURE(BM_KdlRne, robot_name, #robot_name);          \
+  BENCHMARK_CAPTURE(BM_Rnea, robot_name, #robot_name);            \
+  BENCHMARK_CAPTURE(BM_RneaRigid, robot_name, #robot_name);       \
+  BENCHMARK_CAPTURE(BM_TorqueRegressor, robot_name, #robot_name); \
+  BENCHMARK_CAPTURE(BM_EnergyRegressor, robot_name, #robot_name); \
+  BENCHMARK_CAPTURE(BM_MassMatrix, robot_name, #robot_name);
+
+DYNID_ROBOT_BENCH(puma560)
+DYNID_ROBOT_BENCH(iiwa14)
+
+BENCHMARK_MAIN();
