@@ -35,6 +35,22 @@ LinkParams link_params_from_com(double m, const Eigen::Vector3d& c, const Eigen:
   return p;
 }
 
+LinkParams transform_link_params(const LinkParams& p, const Eigen::Matrix3d& R_AB,
+                                 const Eigen::Vector3d& p_AB) {
+  const double m = p(9);
+  const Eigen::Vector3d h = R_AB * p.segment<3>(6);  // first moment in A's axes, about B's origin
+  const Eigen::Matrix3d I3 = Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d I_A = R_AB * inertia_about_origin(p) * R_AB.transpose() +
+                              2.0 * p_AB.dot(h) * I3 -
+                              (p_AB * h.transpose() + h * p_AB.transpose()) +
+                              m * (p_AB.squaredNorm() * I3 - p_AB * p_AB.transpose());
+  const Eigen::Vector3d h_A = h + m * p_AB;
+  LinkParams out;
+  out << I_A(0, 0), I_A(0, 1), I_A(0, 2), I_A(1, 1), I_A(1, 2), I_A(2, 2), h_A.x(), h_A.y(),
+      h_A.z(), m;
+  return out;
+}
+
 namespace {
 
 bool all_finite(const Eigen::Ref<const Eigen::MatrixXd>& m) {

@@ -96,4 +96,13 @@ LinkParams link_params_from_com(double m, const Eigen::Vector3d& c, const Eigen:
 /// The 3×3 inertia about the link origin from standard parameters.
 Eigen::Matrix3d inertia_about_origin(const LinkParams& p);
 
+/// Expresses the standard parameters p of a body, given about the origin of frame B in frame B, in
+/// a frame A where frame B has pose (R_AB, p_AB): returns the same body's parameters about A's
+/// origin in A's axes. Identity: with r' = R_AB·r + p_AB for every mass element, h' = R_AB·h +
+/// m·p_AB and I'_O = R_AB·I_O·R_ABᵀ + (2 p_ABᵀ(R_AB h))·1 − (p_AB (R_AB h)ᵀ + (R_AB h) p_ABᵀ) +
+/// m(|p_AB|²·1 − p_AB p_ABᵀ) (seed 1 eq. 24 generalised; division-free, valid for m = 0). Used to
+/// merge links across fixed joints (docs/methods/model.md).
+LinkParams transform_link_params(const LinkParams& p, const Eigen::Matrix3d& R_AB,
+                                 const Eigen::Vector3d& p_AB);
+
 }  // namespace dynid

@@ -1,0 +1,34 @@
+#pragma once
+
+#include <string>
+
+#include "dynid/model/model.hpp"
+
+namespace dynid {
+
+/// Reads a URDF file and builds a finalized Model (see parse_urdf for the mapping).
+/// Throws dynid::Error "cannot open robot file '<path>'" when the file cannot be read, and every
+/// error of parse_urdf.
+Model load_urdf(const std::string& path);
+
+/// Builds a finalized Model from URDF text; `source` names the text in error messages and is stored
+/// in Model::source. Mapping (docs/methods/model.md, "URDF"):
+/// - link frame j = frame of the URDF joint whose child is link j; R_PJ/p_PJ = the joint <origin>
+///   composed with every fixed joint between the moving parent and this joint; axis = <axis> (in
+///   frame j). Joint order: depth-first from the root link, children in the order their <joint>
+///   elements appear in the file.
+/// - revolute, continuous (position limits ±inf) and prismatic joints become Joints; fixed joints
+///   are merged: the child's inertia is added to the moving ancestor link (transform_link_params)
+///   and the grandchildren are re-parented with the composed transform. Mass fixed to the world
+///   (the root link and everything fixed to it) does not move and is dropped.
+/// - <inertial> with origin xyz/rpy: I = R·I_in·Rᵀ, then the parallel-axis theorem
+///   (link_params_from_com, seed 1 eq. 24). <dynamics damping friction> -> Fv, Fc.
+/// - <limit lower upper velocity effort>; a velocity or effort of 0 (unset) means unlimited.
+/// Throws dynid::Error for malformed XML, unsupported joint types (floating, planar), a robot with
+/// no moving joint, and every check of Model::finalize (non-physical inertia, ...).
+Model parse_urdf(const std::string& xml, const std::string& source);
+
+/// Reads a whole text file. Throws dynid::Error "cannot open robot file '<path>'; ..." on failure.
+std::string read_robot_file(const std::string& path);
+
+}  // namespace dynid
