@@ -1,0 +1,153 @@
+// MuJoCo plant: the model exported by to_urdf() and loaded from an in-memory VFS.
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <mujoco/mujoco.h>
+
+#include "dynid/common/error.hpp"
+#include "dynid/io/urdf_writer.hpp"
+#include "sim/plant_internal.hpp"
+
+namespace dynid::detail {
+
+namespace {
+
+struct VfsDeleter {
+  void operator()(mjVFS* vfs) const {
+    mj_deleteVFS(vfs);
+    delete vfs;
+  }
+};
+struct ModelDeleter {
+  void operator()(mjModel* m) const { mj_deleteModel(m); }
+};
+struct DataDeleter {
+  void operator()(mjData* d) const { mj_deleteData(d); }
+};
+
+class MujocoPlant final : public Plant {
+ public:
+  MujocoPlant(const Model& model, double dt, const MujocoPlantOptions& options)
+      : n_(model.dof()),
+        dt_(dt),
+        q_(Eigen::VectorXd::Zero(n_)),
+        dq_(Eigen::VectorXd::Zero(n_)),
+        offset_(n_) {
+    UrdfWriteOptions urdf_options;
+    urdf_options.mujoco_compiler_tag = true;
+    const std::string urdf = to_urdf(model, urdf_options);
+    const std::string file = "dynid_plant.urdf";
+    std::unique_ptr<mjVFS, VfsDeleter> vfs(new mjVFS);
+    mj_defaultVFS(vfs.get());
+    if (mj_makeEmptyFileVFS(vfs.get(), file.c_str(), static_cast<int>(urdf.size())) != 0)
+      throw Error("mujoco plant: cannot create the in-memory URDF for model '" + model.name + "'");
+    const int index = mj_findFileVFS(vfs.get(), file.c_str());
+    std::memcpy(vfs->filedata[index], urdf.data(), urdf.size());
+    char error[1000] = "";
+    m_.reset(mj_loadXML(file.c_str(), vfs.get(), error, sizeof(error)));
+    if (!m_)
+      throw Error("mujoco plant: MuJoCo rejected model '" + model.name + "': " + error +
+                  " (use the native engine or fix the model)");
+    if (m_->nq != n_ || m_->nv != n_)
+      throw Error("mujoco plant: MuJoCo built " + std::to_string(m_->nv) + " DoF for model '" +
+                  model.name + "' with " + std::to_string(n_) + " joints; use the native engine");
+    d_.reset(mj_makeData(m_.get()));
+    qpos_.resize(n_);
+    dof_.resize(n_);
+    for (int j = 0; j < n_; ++j) {
+      const Joint& joint = model.joints[j];
+      const int id = mj_name2id(m_.get(), mjOBJ_JOINT, joint.name.c_str());
+      if (id < 0)
+        throw Error("mujoco plant: joint '" + joint.name + "' missing after the URDF import");
+      qpos_[j] = m_->jnt_qposadr[id];
+      dof_[j] = m_->jnt_dofadr[id];
+      m_->dof_armature[dof_[j]] = joint.friction.Ia;
+      m_->dof_damping[dof_[j]] = joint.friction.Fv;
+      m_->dof_frictionloss[dof_[j]] = options.coulomb ? joint.friction.Fc : 0.0;
+      offset_[j] = joint.friction.Fo;
+    }
+    for (int k = 0; k < 3; ++k) m_->opt.gravity[k] = model.gravity[k];
+    m_->opt.timestep = dt;
+    m_->opt.integrator = options.integrator == MujocoIntegrator::kRk4 ? mjINT_RK4 : mjINT_IMPLICIT;
+    m_->opt.disableflags |= mjDSBL_CONTACT | mjDSBL_EQUALITY;
+    if (!options.enforce_limits) m_->opt.disableflags |= mjDSBL_LIMIT;
+    reset(q_, dq_);
+  }
+
+  int dof() const override { return n_; }
+  double dt() const override { return dt_; }
+  double time() const override { return d_->time; }
+  std::string engine() const override { return "mujoco"; }
+  const Eigen::VectorXd& q() const override { return q_; }
+  const Eigen::VectorXd& dq() const override { return dq_; }
+
+  void reset(const Eigen::Ref<const Eigen::VectorXd>& q0,
+             const Eigen::Ref<const Eigen::VectorXd>& dq0) override {
+    check_state(n_, q0, dq0);
+    mj_resetData(m_.get(), d_.get());
+    for (int j = 0; j < n_; ++j) {
+      d_->qpos[qpos_[j]] = q0[j];
+      d_->qvel[dof_[j]] = dq0[j];
+    }
+    q_ = q0;
+    dq_ = dq0;
+  }
+
+  void acceleration(const Eigen::Ref<const Eigen::VectorXd>& tau,
+                    Eigen::Ref<Eigen::VectorXd> ddq) override {
+    apply(tau);
+    mj_forward(m_.get(), d_.get());
+    for (int j = 0; j < n_; ++j) ddq[j] = d_->qacc[dof_[j]];
+  }
+
+  void step(const Eigen::Ref<const Eigen::VectorXd>& tau) override {
+    apply(tau);
+    const int bad = d_->warning[mjWARN_BADQACC].number;
+    mj_step(m_.get(), d_.get());
+    for (int j = 0; j < n_; ++j) {
+      q_[j] = d_->qpos[qpos_[j]];
+      dq_[j] = d_->qvel[dof_[j]];
+    }
+    if (d_->warning[mjWARN_BADQACC].number != bad || !q_.allFinite() || !dq_.allFinite())
+      throw Error("mujoco plant: the simulation diverged at t = " + std::to_string(d_->time) +
+                  " s (MuJoCo reset it); lower the torque or the sample time dt");
+  }
+
+ private:
+  // Joint torque tau minus the constant offset Fo (MuJoCo has no such term).
+  void apply(const Eigen::Ref<const Eigen::VectorXd>& tau) {
+    check_torque(n_, tau);
+    for (int j = 0; j < n_; ++j) d_->qfrc_applied[dof_[j]] = tau[j] - offset_[j];
+  }
+
+  int n_;
+  double dt_;
+  Eigen::VectorXd q_, dq_, offset_;
+  std::vector<int> qpos_, dof_;
+  std::unique_ptr<mjModel, ModelDeleter> m_;
+  std::unique_ptr<mjData, DataDeleter> d_;
+};
+
+}  // namespace
+
+std::unique_ptr<Plant> make_mujoco_plant(const Model& model, double dt,
+                                         const MujocoPlantOptions& options) {
+  return std::make_unique<MujocoPlant>(model, dt, options);
+}
+
+}  // namespace dynid::detail
+
+namespace dynid {
+
+std::unique_ptr<Plant> make_plant(const Model& model, const PlantOptions& options) {
+  if (!(options.dt > 0.0) || !std::isfinite(options.dt))
+    throw Error("plant dt must be a finite sample time > 0 [s], e.g. 0.001");
+  if (model.dof() == 0) throw Error("plant model '" + model.name + "' has no joints");
+  if (options.engine == PlantEngine::kMujoco)
+    return detail::make_mujoco_plant(model, options.dt, options.mujoco);
+  return detail::make_native_plant(model, options.dt, options.native);
+}
+
+}  // namespace dynid

@@ -1,0 +1,48 @@
+#include "dynid/sim/simulation_validation.hpp"
+
+#include <string>
+
+#include "dynid/common/error.hpp"
+
+namespace dynid {
+
+SimulationValidation validate_by_simulation(const Model& identified, const Reference& reference,
+                                            const PidOptions& controller,
+                                            const Eigen::Ref<const Eigen::MatrixXd>& q_measured,
+                                            const Eigen::Ref<const Eigen::MatrixXd>& tau_measured,
+                                            const SimulationValidationOptions& options) {
+  const int n = identified.dof();
+  const long rows = q_measured.rows();
+  if (q_measured.cols() != n || tau_measured.cols() != n || tau_measured.rows() != rows)
+    throw Error("measured q and tau must both be N x " + std::to_string(n) +
+                " (samples x joints of the identified model), got " +
+                std::to_string(q_measured.rows()) + "x" + std::to_string(q_measured.cols()) +
+                " and " + std::to_string(tau_measured.rows()) + "x" +
+                std::to_string(tau_measured.cols()));
+  if (!q_measured.allFinite() || !tau_measured.allFinite())
+    throw Error("measured q or tau has NaN or Inf values: clean or trim the measured run");
+  if (options.skip_samples < 0 || rows - options.skip_samples < 2)
+    throw Error("skip_samples = " + std::to_string(options.skip_samples) +
+                " leaves fewer than 2 of " + std::to_string(rows) +
+                " measured samples: lower skip_samples");
+  PlantOptions plant_options = options.plant;
+  plant_options.dt = controller.sample_time;
+  auto plant = make_plant(identified, plant_options);
+  PidController pid(identified, controller);
+  Sensors sensors(identified, SensorOptions{});
+  ClosedLoopOptions loop;
+  loop.samples = rows;
+  if (options.start_at_measured) loop.q0 = q_measured.row(0).transpose();
+  SimulationValidation out;
+  out.simulated = run_closed_loop(reference, pid, *plant, sensors, loop);
+  out.position_error = q_measured - out.simulated.q;
+  out.torque_error = tau_measured - out.simulated.tau;
+  const long used = rows - options.skip_samples;
+  for (int j = 0; j < n; ++j) {
+    out.position.push_back(error_statistics(out.position_error.col(j).tail(used)));
+    out.torque.push_back(error_statistics(out.torque_error.col(j).tail(used)));
+  }
+  return out;
+}
+
+}  // namespace dynid
