@@ -1,0 +1,24 @@
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "dynid/io/csv_table.hpp"
+
+namespace dynid {
+
+/// Reads a whole CSV file (DESIGN.md section 4) into memory.
+/// Format: first non-comment, non-blank line is the header (names, optionally double-quoted); then
+/// one row of numbers per line, comma separated; lines whose first non-blank character is `#` are
+/// comments; CRLF or LF line ends; blank lines are skipped; spaces/tabs around fields are ignored.
+/// Numbers are parsed with fast_float (exact round trip of shortest/%.17g output).
+/// Throws dynid::Error (one line naming file, line and column, and the fix) for: missing or
+/// unreadable file, empty file, numeric first line (no header), empty or duplicate column names,
+/// ragged rows, non-numeric fields, NaN/Inf values, and a truncated last line (no final newline and
+/// too few fields or a partial number).
+CsvTable read_csv(const std::string& path);
+
+/// Same as read_csv on text already in memory; `source` names it in error messages.
+CsvTable parse_csv(std::string_view text, const std::string& source);
+
+}  // namespace dynid

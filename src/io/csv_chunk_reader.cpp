@@ -1,0 +1,144 @@
+#include "dynid/io/csv_chunk_reader.hpp"
+
+#include <cerrno>
+#include <cstring>
+
+#include "dynid/common/error.hpp"
+#include "io/csv_parse.hpp"
+
+namespace dynid {
+
+struct CsvChunkReader::Impl {
+  std::string source;
+  CsvChunkOptions options;
+  std::FILE* file = nullptr;
+  std::vector<char> buffer;
+  std::size_t pos = 0;     // start of unread text in buffer
+  std::size_t filled = 0;  // end of valid text in buffer
+  bool eof = false;
+  long line = 0;
+  Eigen::Index rows = 0;
+  std::vector<std::string> columns;
+  Eigen::MatrixXd scratch;  // full chunk_rows block, reused
+
+  ~Impl() {
+    if (file != nullptr) std::fclose(file);
+  }
+
+  // Next line as [b, e) without CR/LF. Returns false at the end of the file.
+  bool next_line(const char*& b, const char*& e, bool& terminated) {
+    while (true) {
+      char* start = buffer.data() + pos;
+      const std::size_t avail = filled - pos;
+      char* nl = static_cast<char*>(std::memchr(start, '\n', avail));
+      if (nl != nullptr) {
+        b = start;
+        e = csv_detail::strip_cr(b, nl);
+        terminated = true;
+        pos += static_cast<std::size_t>(nl - start) + 1;
+        ++line;
+        return true;
+      }
+      if (eof) {
+        if (avail == 0) return false;
+        b = start;
+        e = csv_detail::strip_cr(b, start + avail);
+        terminated = false;
+        pos = filled;
+        ++line;
+        return true;
+      }
+      // Keep the partial line, then read more (grow only for a line longer than the buffer).
+      std::memmove(buffer.data(), start, avail);
+      pos = 0;
+      filled = avail;
+      if (filled == buffer.size()) buffer.resize(buffer.size() * 2);
+      const std::size_t got = std::fread(buffer.data() + filled, 1, buffer.size() - filled, file);
+      filled += got;
+      if (got == 0) {
+        if (std::ferror(file)) {
+          throw Error(source + ": read error (" + std::strerror(errno) + "); check the file");
+        }
+        eof = true;
+      }
+    }
+  }
+};
+
+CsvChunkReader::CsvChunkReader(const std::string& path, const CsvChunkOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  if (options.chunk_rows < 1) {
+    throw Error("CsvChunkOptions::chunk_rows is " + std::to_string(options.chunk_rows) +
+                "; use a positive number of rows");
+  }
+  impl_->source = path;
+  impl_->options = options;
+  impl_->buffer.resize(std::max<std::size_t>(options.buffer_bytes, 64));
+  impl_->file = std::fopen(path.c_str(), "rb");
+  if (impl_->file == nullptr) {
+    throw Error(path + ": cannot open (" + std::strerror(errno) +
+                "); check the path given to --in");
+  }
+  const char* b = nullptr;
+  const char* e = nullptr;
+  bool terminated = true;
+  while (impl_->next_line(b, e, terminated)) {
+    if (csv_detail::is_skippable(b, e)) continue;
+    impl_->columns = csv_detail::parse_header(b, e, path, impl_->line);
+    impl_->scratch.resize(options.chunk_rows, static_cast<Eigen::Index>(impl_->columns.size()));
+    return;
+  }
+  csv_detail::throw_empty(path);
+}
+
+CsvChunkReader::~CsvChunkReader() = default;
+
+const std::vector<std::string>& CsvChunkReader::columns() const {
+  return impl_->columns;
+}
+
+Eigen::Index CsvChunkReader::rows_read() const {
+  return impl_->rows;
+}
+
+bool CsvChunkReader::next(Eigen::MatrixXd& block) {
+  Impl& s = *impl_;
+  const Eigen::Index capacity = s.options.chunk_rows;
+  const auto n = static_cast<Eigen::Index>(s.columns.size());
+  Eigen::Index count = 0;
+  const char* b = nullptr;
+  const char* e = nullptr;
+  bool terminated = true;
+  // Parse straight into `block` when it already has the full chunk shape (the common case).
+  const bool direct = block.rows() == capacity && block.cols() == n;
+  Eigen::MatrixXd& target = direct ? block : s.scratch;
+  while (count < capacity && s.next_line(b, e, terminated)) {
+    if (csv_detail::is_skippable(b, e)) continue;
+    csv_detail::parse_row(b, e, s.columns, target.data() + count, capacity, s.source, s.line,
+                          static_cast<long>(s.rows + count) + 1, !terminated);
+    ++count;
+  }
+  s.rows += count;
+  if (count == 0 && s.rows == 0) {
+    throw Error(s.source + ": header but no data rows; add one line of numbers per sample");
+  }
+  if (direct && count == capacity) return true;
+  block = target.topRows(count).eval();  // eval: target may alias block
+  return count > 0;
+}
+
+void for_each_csv_chunk(
+    const std::string& path,
+    const std::function<void(const std::vector<std::string>& columns, const Eigen::MatrixXd& block,
+                             Eigen::Index first_row)>& callback,
+    const CsvChunkOptions& options) {
+  CsvChunkReader reader(path, options);
+  Eigen::MatrixXd block(options.chunk_rows, static_cast<Eigen::Index>(reader.columns().size()));
+  Eigen::Index first = 0;
+  while (reader.next(block)) {
+    callback(reader.columns(), block, first);
+    first = reader.rows_read();
+  }
+}
+
+}  // namespace dynid

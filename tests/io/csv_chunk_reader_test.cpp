@@ -1,0 +1,78 @@
+#include "dynid/io/csv_chunk_reader.hpp"
+
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "dynid/io/csv_reader.hpp"
+#include "dynid/io/csv_writer.hpp"
+#include "io/io_test_support.hpp"
+
+namespace dynid {
+namespace {
+
+using test::error_of;
+using test::TempDir;
+
+// Oracle: read_csv of the same file (itself checked against literals in csv_reader_test).
+TEST(CsvChunkReader, BlocksConcatenateToTheWholeFileForAnyChunkAndBufferSize) {
+  TempDir dir;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd data(1001, 3);
+  for (Eigen::Index i = 0; i < data.size(); ++i) data.data()[i] = normal(rng);
+  std::string text = "# comment\r\n" + format_csv({"t", "q1", "dq1"}, data);
+  // Comments and CRLF in the middle; a complete last line without newline.
+  text.insert(text.find('\n', 200) + 1, "# mid comment\n\n");
+  text.pop_back();
+  const std::string path = dir.write("big.csv", text);
+  const CsvTable whole = read_csv(path);
+  ASSERT_EQ(whole.rows(), 1001);
+  ASSERT_EQ(whole.data, data);
+  for (const Eigen::Index chunk : {1, 3, 64, 1000, 5000}) {
+    for (const std::size_t buffer : {std::size_t{16}, std::size_t{97}, std::size_t{1} << 20}) {
+      CsvChunkReader reader(path, {chunk, buffer});
+      EXPECT_EQ(reader.columns(), whole.columns);
+      Eigen::MatrixXd block;
+      Eigen::Index row = 0;
+      while (reader.next(block)) {
+        ASSERT_LE(block.rows(), chunk);
+        ASSERT_EQ(block, whole.data.middleRows(row, block.rows())) << chunk << " " << buffer;
+        row += block.rows();
+      }
+      EXPECT_EQ(row, 1001);
+      EXPECT_EQ(reader.rows_read(), 1001);
+    }
+  }
+  Eigen::Index seen = 0;
+  for_each_csv_chunk(path,
+                     [&](const std::vector<std::string>& columns, const Eigen::MatrixXd& block,
+                         Eigen::Index first) {
+                       EXPECT_EQ(columns.size(), 3u);
+                       EXPECT_EQ(first, seen);
+                       EXPECT_EQ(block, whole.data.middleRows(first, block.rows()));
+                       seen += block.rows();
+                     },
+                     {100, 4096});
+  EXPECT_EQ(seen, 1001);
+}
+
+TEST(CsvChunkReader, ErrorsNameFileAndLine) {
+  TempDir dir;
+  EXPECT_HAS(error_of([&] { CsvChunkReader r(dir.file("none.csv")); }), "none.csv: cannot open");
+  EXPECT_HAS(error_of([&] { CsvChunkReader r(dir.write("e.csv", "\n# x\n")); }),
+             "e.csv: file is empty");
+  EXPECT_HAS(error_of([&] { CsvChunkReader r(dir.write("d.csv", "a,a\n1,2\n")); }),
+             "d.csv:1: duplicate column name 'a'");
+  const std::string bad = dir.write("bad.csv", "a,b\n1,2\n3,4\n5,nan\n7,8\n");
+  CsvChunkReader reader(bad, {2, 16});
+  Eigen::MatrixXd block;
+  ASSERT_TRUE(reader.next(block));
+  EXPECT_HAS(error_of([&] { reader.next(block); }),
+             "bad.csv:4: column 'b' (field 2) of data row 3 is NaN");
+  CsvChunkReader truncated(dir.write("t.csv", "a,b\n1,2\n3"), {10, 16});
+  EXPECT_HAS(error_of([&] { truncated.next(block); }), "t.csv:3: truncated last line");
+}
+
+}  // namespace
+}  // namespace dynid
