@@ -7,6 +7,7 @@
 #include <Eigen/QR>
 
 #include "dynid/common/error.hpp"
+#include "dynid/model/transmission.hpp"
 #include "dynid/regressor/energy_regressor.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
 
@@ -29,6 +30,10 @@ Eigen::MatrixXd sample_regressor(const Model& model, const BaseParameterOptions&
                                  int samples) {
   const int n = model.dof();
   const int p = options.layout.columns(n);
+  const std::vector<int> motors = coupled_motors(model);
+  const int extra = options.coupling && options.regressor == BaseRegressor::kTorque
+                        ? 3 * static_cast<int>(motors.size())
+                        : 0;
   Workspace ws(model);
   std::mt19937 rng(options.seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -41,10 +46,11 @@ Eigen::MatrixXd sample_regressor(const Model& model, const BaseParameterOptions&
     }
   };
   if (options.regressor == BaseRegressor::kTorque) {
-    Eigen::MatrixXd W(static_cast<Eigen::Index>(samples) * n, p);
+    Eigen::MatrixXd W(static_cast<Eigen::Index>(samples) * n, p + extra);
     for (int k = 0; k < samples; ++k) {
       draw();
-      torque_regressor(model, ws, options.layout, q, dq, ddq, W.middleRows(k * n, n));
+      torque_regressor(model, ws, options.layout, q, dq, ddq, W.block(k * n, 0, n, p));
+      if (extra) coupling_regressor(model, motors, dq, ddq, W.block(k * n, p, n, extra));
     }
     return W;
   }
@@ -141,8 +147,11 @@ BaseParameters compute_base_parameters(const Model& model, const BaseParameterOp
   const int p = options.layout.columns(n);
   const int samples =
       options.samples > 0 ? options.samples : std::max(100, 4 * p / std::max(1, n) + 50);
-  BaseParameters out =
-      classify_columns(sample_regressor(model, options, samples), options.layout.names(n), options);
+  std::vector<std::string> names = options.layout.names(n);
+  if (options.coupling && options.regressor == BaseRegressor::kTorque) {
+    for (const auto& name : coupling_column_names(model)) names.push_back(name);
+  }
+  BaseParameters out = classify_columns(sample_regressor(model, options, samples), names, options);
   out.samples = samples;
   return out;
 }

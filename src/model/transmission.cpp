@@ -15,7 +15,9 @@ void check_columns(const Model& model, Eigen::Index cols, const char* what) {
   }
 }
 
-double sign(double x) { return static_cast<double>((x > 0.0) - (x < 0.0)); }
+double sign(double x) {
+  return static_cast<double>((x > 0.0) - (x < 0.0));
+}
 
 }  // namespace
 
@@ -43,7 +45,9 @@ std::vector<int> coupled_motors(const Model& model) {
   return out;
 }
 
-int coupling_columns(const Model& model) { return 3 * static_cast<int>(coupled_motors(model).size()); }
+int coupling_columns(const Model& model) {
+  return 3 * static_cast<int>(coupled_motors(model).size());
+}
 
 std::vector<std::string> coupling_column_names(const Model& model) {
   std::vector<std::string> names;
@@ -56,7 +60,8 @@ std::vector<std::string> coupling_column_names(const Model& model) {
 
 void coupling_regressor(const Model& model, const std::vector<int>& motors,
                         const Eigen::Ref<const Eigen::VectorXd>& dq,
-                        const Eigen::Ref<const Eigen::VectorXd>& ddq, Eigen::Ref<Eigen::MatrixXd> out) {
+                        const Eigen::Ref<const Eigen::VectorXd>& ddq,
+                        Eigen::Ref<Eigen::MatrixXd> out) {
   const Eigen::MatrixXd& N = model.transmission.N;
   out.setZero();
   for (size_t c = 0; c < motors.size(); ++c) {

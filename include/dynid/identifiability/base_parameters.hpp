@@ -20,6 +20,8 @@ enum class BaseRegressor {
 /// Options of the numerical base-parameter computation.
 struct BaseParameterOptions {
   ParameterLayout layout;  ///< columns to classify (link + per-joint terms)
+  bool coupling =
+      false;  ///< append the coupled-motor columns (model/transmission.hpp), torque only
   BaseRegressor regressor = BaseRegressor::kTorque;  ///< which model is sampled
   int samples = 0;           ///< random states; 0 = max(100, 4·columns/n) (enough for full rank)
   unsigned seed = 20261123;  ///< fixed seed: the same model gives the same base set every time

@@ -12,11 +12,13 @@ namespace dynid {
 /// Motor-side positions to joint positions (DESIGN.md §3): q = N⁻¹·q_motor + q_offset, row by row.
 /// qm: samples × n [motor rad]; returns samples × n [rad or m]. Throws dynid::Error on a column
 /// count that is not the model's dof.
-Eigen::MatrixXd joint_positions_from_motor(const Model& model, const Eigen::Ref<const Eigen::MatrixXd>& qm);
+Eigen::MatrixXd joint_positions_from_motor(const Model& model,
+                                           const Eigen::Ref<const Eigen::MatrixXd>& qm);
 
 /// Motor-side torques to joint torques: tau = Nᵀ·tau_motor, row by row (power is preserved:
 /// tau_motorᵀ·dq_motor = tauᵀ·dq). taum: samples × n [N·m]; returns samples × n.
-Eigen::MatrixXd joint_torques_from_motor(const Model& model, const Eigen::Ref<const Eigen::MatrixXd>& taum);
+Eigen::MatrixXd joint_torques_from_motor(const Model& model,
+                                         const Eigen::Ref<const Eigen::MatrixXd>& taum);
 
 /// Motors whose row of N drives more than one joint (a coupled wrist such as the Stäubli TX40's,
 /// where q6_motor = N66·(q5 + q6)); 0-based motor indices.
@@ -36,6 +38,7 @@ std::vector<std::string> coupling_column_names(const Model& model);
 /// n_kj·sign(n_k·dq) (Fcm). Values are joint-side (scaled by s²). dq, ddq: n; out: n × 3·(#motors).
 void coupling_regressor(const Model& model, const std::vector<int>& motors,
                         const Eigen::Ref<const Eigen::VectorXd>& dq,
-                        const Eigen::Ref<const Eigen::VectorXd>& ddq, Eigen::Ref<Eigen::MatrixXd> out);
+                        const Eigen::Ref<const Eigen::VectorXd>& ddq,
+                        Eigen::Ref<Eigen::MatrixXd> out);
 
 }  // namespace dynid

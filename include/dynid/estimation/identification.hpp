@@ -1,0 +1,118 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "dynid/estimation/estimate.hpp"
+#include "dynid/identifiability/base_parameters.hpp"
+#include "dynid/model/model.hpp"
+#include "dynid/regressor/parameter_layout.hpp"
+#include "dynid/signal/lowpass_design.hpp"
+
+namespace dynid {
+
+/// A recorded run on the joint side: time, positions, optional derivatives, torques.
+struct JointRecord {
+  Eigen::VectorXd t;    ///< m time stamps [s], strictly increasing
+  Eigen::MatrixXd q;    ///< m × n [rad or m]
+  Eigen::MatrixXd dq;   ///< m × n or empty: derived from q when absent
+  Eigen::MatrixXd ddq;  ///< m × n or empty: derived from dq when absent
+  Eigen::MatrixXd tau;  ///< m × n joint torques [N·m or N]
+};
+
+/// Signal processing before estimation (issue 4; seed 2 §3.4, Gautier's parallel filtering).
+/// Negative / zero "auto" values are replaced by defaults that the result reports back.
+struct SignalOptions {
+  bool filter =
+      true;  ///< zero-phase low-pass of q and tau with the same filter (parallel filtering)
+  LowpassFamily family = LowpassFamily::kButterworth;  ///< filter prototype
+  int order = 4;                                       ///< filter order
+  double cutoff_hz = 0.0;  ///< 0 = auto: min(20 Hz, rate/10) (arm dynamics live below ~10 Hz)
+  double ripple_db = 0.5;  ///< Chebyshev I passband ripple
+  int decimate = 0;        ///< keep every k-th sample; 0 = auto: rate/(10·cutoff), ≥ 1
+  int trim = -1;  ///< samples dropped at each end after filtering; −1 = auto: 3·rate/cutoff
+  bool savitzky_golay =
+      false;  ///< differentiate with Savitzky–Golay instead of central differences
+  /// Coulomb friction is undefined near dq = 0: rows of joint j with |dq_j| below the threshold are
+  /// removed. Empty = auto: 1 % of max|dq_j| per joint. One value = all joints; else n values.
+  std::vector<double> zero_velocity;
+};
+
+enum class IdentificationEstimator { kOls, kWls, kRls };
+
+/// Options of identify().
+struct IdentifyOptions {
+  ParameterLayout layout = ParameterLayout::full();  ///< link + per-joint columns to identify
+  bool coupling = true;  ///< add the coupled-motor columns when the transmission couples joints
+  IdentificationEstimator estimator = IdentificationEstimator::kOls;  ///< batch or recursive
+  double confidence_level = 0.999;  ///< Student-t interval level (seed 2 Table 3)
+  SignalOptions signal;             ///< filtering, derivatives, decimation, sample removal
+  BaseParameterOptions base;        ///< base-parameter computation (layout is overwritten)
+};
+
+/// The preprocessed data actually used for estimation (useful for plots and validation).
+struct ProcessedRecord {
+  JointRecord record;    ///< filtered, differentiated, trimmed and decimated
+  double rate_hz = 0.0;  ///< sample rate of `record`
+};
+
+/// Everything identify() found, ready to be written as the JSON of DESIGN.md §4.
+struct IdentificationResult {
+  std::vector<std::string> names;           ///< base parameter names (ZZ1R, …, Fv1, …)
+  std::vector<std::string> expressions;     ///< regrouping expressions, one per base parameter
+  std::vector<std::string> unidentifiable;  ///< standard parameters with no effect at all
+  Estimate estimate;                        ///< values, σ, %σ, CI, residual statistics, summary
+  int rank = 0;                             ///< base parameters (model rank)
+  double condition_number = 0.0;            ///< of the (weighted) base regressor on these data
+  Eigen::Index samples = 0;                 ///< samples used after processing
+  Eigen::Index rows = 0;                    ///< equations used (after zero-velocity removal)
+  Eigen::VectorXd residual_rms;             ///< per joint [N·m]
+  Eigen::VectorXd joint_relative_error;     ///< per joint ‖e_j‖/‖tau_j‖
+  double relative_error = 0.0;              ///< ‖tau − Ŷθ̂‖/‖tau‖ over the rows used
+  std::vector<std::string> warnings;        ///< named, human-readable
+  std::vector<std::pair<std::string, std::string>> choices;  ///< every processing choice made
+  BaseParameters base;        ///< the base set on which the estimate lives
+  ProcessedRecord processed;  ///< the data as used
+};
+
+/// Sample-major stacked regressor of the layout plus coupling columns for a record:
+/// rows k·n … k·n+n−1 are sample k. Size (m·n) × (layout.columns(n) + coupling_columns(model)).
+Eigen::MatrixXd stacked_regressor(const Model& model, const ParameterLayout& layout, bool coupling,
+                                  const JointRecord& record);
+
+/// Names of the columns of stacked_regressor.
+std::vector<std::string> stacked_regressor_names(const Model& model, const ParameterLayout& layout,
+                                                 bool coupling);
+
+/// Filters, differentiates, trims and decimates a record as SignalOptions says; fills in the auto
+/// choices (written to `choices`). Throws dynid::Error for too few samples or bad time stamps.
+ProcessedRecord preprocess(const JointRecord& record, const SignalOptions& options,
+                           std::vector<std::pair<std::string, std::string>>& choices);
+
+/// Identifies the base parameters of `model` from a joint-side record: preprocess, stack the
+/// regressor (tau = Y·theta, seed 1 eq. 5 / seed 2 eq. 9), keep the base columns (Gautier–Khalil),
+/// estimate by OLS, Gautier's WLS or U-D RLS (seed 1 eqs. 36–37), and report statistics.
+/// Throws dynid::Error for inconsistent sizes, NaN, too few samples.
+IdentificationResult identify(const Model& model, const JointRecord& record,
+                              const IdentifyOptions& options = {});
+
+/// Per-joint prediction error of identified base parameters on another record (dynid validate).
+struct ValidationResult {
+  Eigen::VectorXd rms;              ///< per joint [N·m]
+  Eigen::VectorXd relative_error;   ///< per joint ‖e_j‖/‖tau_j‖
+  double relative_error_all = 0.0;  ///< ‖e‖/‖tau‖ over all joints
+  Eigen::Index samples = 0;
+  ProcessedRecord processed;
+  Eigen::MatrixXd predicted;  ///< samples × n predicted torques
+};
+
+/// Predicts the torques of `record` with base parameters `values` named `names` (as identify()
+/// wrote them) and compares. The base set is recomputed from the model with the same layout; a
+/// name that is not in it is an Error naming the parameter.
+ValidationResult validate_torques(const Model& model, const JointRecord& record,
+                                  const std::vector<std::string>& names,
+                                  const Eigen::VectorXd& values, const IdentifyOptions& options);
+
+}  // namespace dynid

@@ -1,0 +1,330 @@
+#include "dynid/estimation/identification.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/SVD>
+
+#include "dynid/common/error.hpp"
+#include "dynid/estimation/least_squares.hpp"
+#include "dynid/estimation/recursive_least_squares.hpp"
+#include "dynid/model/transmission.hpp"
+#include "dynid/regressor/torque_regressor.hpp"
+#include "dynid/signal/differentiation.hpp"
+#include "dynid/signal/resampling.hpp"
+#include "dynid/signal/sampling_check.hpp"
+#include "dynid/signal/zero_phase_filter.hpp"
+
+namespace dynid {
+
+namespace {
+
+std::string fmt(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+
+void check_record(const JointRecord& r, int n) {
+  const Eigen::Index m = r.t.size();
+  auto check = [&](const Eigen::MatrixXd& x, const char* what, bool optional) {
+    if (optional && x.size() == 0) return;
+    if (x.rows() != m || x.cols() != n) {
+      throw Error(std::string(what) + " has " + std::to_string(x.rows()) + "×" +
+                  std::to_string(x.cols()) + " values; expected " + std::to_string(m) + "×" +
+                  std::to_string(n) + " (samples × joints)");
+    }
+    if (!x.allFinite()) throw Error(std::string(what) + " contains NaN or Inf; clean the data");
+  };
+  check(r.q, "q", false);
+  check(r.dq, "dq", true);
+  check(r.ddq, "ddq", true);
+  check(r.tau, "tau", false);
+}
+
+Eigen::MatrixXd take_rows(const Eigen::MatrixXd& x, Eigen::Index first, Eigen::Index last,
+                          int step) {
+  if (x.size() == 0) return x;
+  const Eigen::Index count = (last - first + step - 1) / step;
+  Eigen::MatrixXd out(count, x.cols());
+  for (Eigen::Index k = 0; k < count; ++k) out.row(k) = x.row(first + k * step);
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> stacked_regressor_names(const Model& model, const ParameterLayout& layout,
+                                                 bool coupling) {
+  std::vector<std::string> names = layout.names(model.dof());
+  if (coupling) {
+    for (const auto& name : coupling_column_names(model)) names.push_back(name);
+  }
+  return names;
+}
+
+Eigen::MatrixXd stacked_regressor(const Model& model, const ParameterLayout& layout, bool coupling,
+                                  const JointRecord& record) {
+  const int n = model.dof();
+  const Eigen::Index m = record.q.rows();
+  const int p = layout.columns(n);
+  const std::vector<int> motors = coupling ? coupled_motors(model) : std::vector<int>{};
+  const int extra = 3 * static_cast<int>(motors.size());
+  Eigen::MatrixXd W(m * n, p + extra);
+  Workspace ws(model);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    const auto q = record.q.row(k).transpose();
+    const auto dq = record.dq.row(k).transpose();
+    const auto ddq = record.ddq.row(k).transpose();
+    torque_regressor(model, ws, layout, q, dq, ddq, W.block(k * n, 0, n, p));
+    if (extra) coupling_regressor(model, motors, dq, ddq, W.block(k * n, p, n, extra));
+  }
+  return W;
+}
+
+ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& options,
+                           std::vector<std::pair<std::string, std::string>>& choices) {
+  const int n = static_cast<int>(input.q.cols());
+  check_record(input, n);
+  if (input.t.size() < 10) {
+    throw Error("the run has " + std::to_string(input.t.size()) +
+                " samples; identification needs at least 10 (more than the parameters)");
+  }
+  SamplingInfo info = check_sampling(input.t, 0.05);
+  JointRecord r = input;
+  if (options.filter && !info.uniform) {
+    // Zero-phase filtering assumes uniform steps: resample first at the mean rate.
+    const double rate = info.rate_hz();
+    Eigen::MatrixXd all(r.t.size(), 0);
+    auto resample = [&](Eigen::MatrixXd& x) {
+      if (x.size() == 0) return;
+      ResampleOptions ro;
+      ro.anti_alias.enabled = false;
+      x = resample_uniform(input.t, x, rate, ro).x;
+    };
+    Eigen::VectorXd t_new = resample_uniform(input.t, input.q, rate, {}).t;
+    resample(r.q);
+    resample(r.dq);
+    resample(r.ddq);
+    resample(r.tau);
+    r.t = t_new;
+    info = check_sampling(r.t, 0.05);
+    choices.emplace_back("resampled",
+                         "uniform at " + fmt(rate) + " Hz (time stamps were not uniform)");
+  }
+  const double rate = info.rate_hz();
+  choices.emplace_back("sample_rate_hz", fmt(rate));
+  double cutoff = options.cutoff_hz;
+  int trim = options.trim;
+  int decimate = options.decimate;
+  if (options.filter) {
+    if (cutoff <= 0.0) cutoff = std::min(20.0, rate / 10.0);
+    LowpassOptions lp;
+    lp.family = options.family;
+    lp.order = options.order;
+    lp.cutoff_hz = cutoff;
+    lp.sample_rate_hz = rate;
+    lp.ripple_db = options.ripple_db;
+    const SosFilter filter = design_lowpass(lp);
+    r.q = filtfilt(filter, r.q);
+    r.tau = filtfilt(filter, r.tau);
+    if (r.dq.size()) r.dq = filtfilt(filter, r.dq);
+    if (r.ddq.size()) r.ddq = filtfilt(filter, r.ddq);
+    choices.emplace_back(
+        "filter",
+        std::string(options.family == LowpassFamily::kButterworth ? "butterworth" : "chebyshev1") +
+            " order " + std::to_string(options.order) + ", cut-off " + fmt(cutoff) +
+            " Hz, zero phase, on q, dq, ddq and tau");
+    if (trim < 0) trim = static_cast<int>(std::ceil(3.0 * rate / cutoff));
+    if (decimate <= 0) decimate = std::max(1, static_cast<int>(std::floor(rate / (10.0 * cutoff))));
+  } else {
+    choices.emplace_back("filter", "none");
+    if (trim < 0) trim = 0;
+    if (decimate <= 0) decimate = 1;
+  }
+  auto differentiate = [&](const Eigen::MatrixXd& x) {
+    if (options.savitzky_golay) {
+      SavitzkyGolayOptions sg;
+      return savitzky_golay(r.t, x, sg);
+    }
+    return central_difference(r.t, x, 1);
+  };
+  const char* method =
+      options.savitzky_golay ? "Savitzky-Golay (window 11, order 3)" : "central differences";
+  if (r.dq.size() == 0) {
+    r.dq = differentiate(r.q);
+    choices.emplace_back("dq", std::string("derived from q by ") + method);
+  } else {
+    choices.emplace_back("dq", "from the data");
+  }
+  if (r.ddq.size() == 0) {
+    r.ddq = differentiate(r.dq);
+    choices.emplace_back("ddq", std::string("derived from dq by ") + method);
+  } else {
+    choices.emplace_back("ddq", "from the data");
+  }
+  const Eigen::Index m = r.t.size();
+  if (2 * static_cast<Eigen::Index>(trim) + 10 > m) {
+    throw Error("the run has " + std::to_string(m) + " samples but " + std::to_string(2 * trim) +
+                " are trimmed as filter edges; record a longer run or set --trim / --cutoff");
+  }
+  choices.emplace_back("trim", std::to_string(trim) + " samples at each end");
+  choices.emplace_back("decimate", std::to_string(decimate));
+  ProcessedRecord out;
+  const Eigen::Index first = trim, last = m - trim;
+  out.record.t = take_rows(r.t, first, last, decimate);
+  out.record.q = take_rows(r.q, first, last, decimate);
+  out.record.dq = take_rows(r.dq, first, last, decimate);
+  out.record.ddq = take_rows(r.ddq, first, last, decimate);
+  out.record.tau = take_rows(r.tau, first, last, decimate);
+  out.rate_hz = rate / decimate;
+  return out;
+}
+
+IdentificationResult identify(const Model& model, const JointRecord& record,
+                              const IdentifyOptions& options) {
+  const int n = model.dof();
+  if (record.q.cols() != n) {
+    throw Error("the run has " + std::to_string(record.q.cols()) + " joints but model '" +
+                model.name + "' has " + std::to_string(n));
+  }
+  IdentificationResult result;
+  result.processed = preprocess(record, options.signal, result.choices);
+  const JointRecord& r = result.processed.record;
+  const Eigen::Index m = r.t.size();
+  result.samples = m;
+
+  const bool coupling = options.coupling && !coupled_motors(model).empty();
+  BaseParameterOptions base_options = options.base;
+  base_options.layout = options.layout;
+  base_options.coupling = coupling;
+  result.base = compute_base_parameters(model, base_options);
+  result.names = result.base.names;
+  result.expressions = result.base.expressions;
+  result.unidentifiable = result.base.unidentifiable_names();
+  result.rank = result.base.rank;
+
+  // Rows of joint j where |dq_j| is too small for sign(dq_j) to be meaningful are dropped.
+  Eigen::VectorXd threshold = Eigen::VectorXd::Zero(n);
+  const bool coulomb = options.layout.coulomb;
+  if (coulomb) {
+    const auto& zv = options.signal.zero_velocity;
+    if (zv.empty()) {
+      threshold = 0.01 * r.dq.cwiseAbs().colwise().maxCoeff().transpose();
+    } else if (zv.size() == 1) {
+      threshold.setConstant(zv[0]);
+    } else if (static_cast<int>(zv.size()) == n) {
+      threshold = Eigen::Map<const Eigen::VectorXd>(zv.data(), n);
+    } else {
+      throw UsageError("--zero-velocity takes 1 or " + std::to_string(n) + " values, got " +
+                       std::to_string(zv.size()));
+    }
+    std::ostringstream s;
+    s << "rows with |dq_j| < [" << threshold.transpose() << "] removed (Coulomb friction)";
+    result.choices.emplace_back("zero_velocity", s.str());
+  }
+  const Eigen::MatrixXd W_full = stacked_regressor(model, options.layout, coupling, r);
+  std::vector<Eigen::Index> keep;
+  keep.reserve(m * n);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    for (int j = 0; j < n; ++j) {
+      if (!coulomb || std::abs(r.dq(k, j)) >= threshold[j]) keep.push_back(k * n + j);
+    }
+  }
+  const Eigen::Index rows = static_cast<Eigen::Index>(keep.size());
+  result.rows = rows;
+  if (rows <= result.rank) {
+    throw Error("only " + std::to_string(rows) + " equations remain for " +
+                std::to_string(result.rank) +
+                " base parameters; record a longer or faster run, or lower --zero-velocity");
+  }
+  Eigen::MatrixXd W(rows, result.rank);
+  Eigen::VectorXd y(rows);
+  Eigen::VectorXi groups(rows);
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    for (int c = 0; c < result.rank; ++c) W(i, c) = W_full(keep[i], result.base.base[c]);
+    y[i] = r.tau(keep[i] / n, keep[i] % n);
+    groups[i] = static_cast<int>(keep[i] % n);
+  }
+  EstimationOptions eo;
+  eo.confidence_level = options.confidence_level;
+  eo.names = result.names;
+  switch (options.estimator) {
+    case IdentificationEstimator::kOls:
+      result.estimate = ordinary_least_squares(W, y, groups, eo);
+      break;
+    case IdentificationEstimator::kWls:
+      result.estimate = weighted_least_squares(W, y, groups, eo);
+      break;
+    case IdentificationEstimator::kRls:
+      result.estimate = recursive_least_squares(W, y, {}, eo);
+      break;
+  }
+  // Residuals per joint, unweighted, on the rows used.
+  const Eigen::VectorXd e = y - W * result.estimate.x;
+  Eigen::VectorXd e2 = Eigen::VectorXd::Zero(n), y2 = Eigen::VectorXd::Zero(n),
+                  cnt = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    e2[groups[i]] += e[i] * e[i];
+    y2[groups[i]] += y[i] * y[i];
+    cnt[groups[i]] += 1.0;
+  }
+  result.residual_rms = (e2.array() / cnt.array().max(1.0)).sqrt();
+  result.joint_relative_error = (e2.array() / y2.array().max(1e-300)).sqrt();
+  result.relative_error = e.norm() / y.norm();
+  result.condition_number = result.estimate.summary.condition_number;
+  if (!(result.condition_number > 0.0)) {
+    const Eigen::VectorXd s = Eigen::BDCSVD<Eigen::MatrixXd>(W).singularValues();
+    result.condition_number = s[s.size() - 1] > 0.0 ? s[0] / s[s.size() - 1] : INFINITY;
+  }
+  result.warnings = result.estimate.summary.warnings;
+  return result;
+}
+
+ValidationResult validate_torques(const Model& model, const JointRecord& record,
+                                  const std::vector<std::string>& names,
+                                  const Eigen::VectorXd& values, const IdentifyOptions& options) {
+  const int n = model.dof();
+  if (record.q.cols() != n) {
+    throw Error("the run has " + std::to_string(record.q.cols()) + " joints but model '" +
+                model.name + "' has " + std::to_string(n));
+  }
+  std::vector<std::pair<std::string, std::string>> choices;
+  ValidationResult out;
+  out.processed = preprocess(record, options.signal, choices);
+  const JointRecord& r = out.processed.record;
+  const std::vector<std::string> columns = stacked_regressor_names(
+      model, options.layout, options.coupling && !coupled_motors(model).empty());
+  // Each identified parameter selects its leading standard column: W_b·theta_b uses the base
+  // columns only (W_2 = W_1·K_d is folded into theta_b).
+  Eigen::VectorXd theta = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(columns.size()));
+  for (size_t i = 0; i < names.size(); ++i) {
+    std::string lead = names[i];
+    auto it = std::find(columns.begin(), columns.end(), lead);
+    if (it == columns.end() && !lead.empty() && lead.back() == 'R') {
+      lead.pop_back();
+      it = std::find(columns.begin(), columns.end(), lead);
+    }
+    if (it == columns.end()) {
+      throw Error("parameter '" + names[i] +
+                  "' of the result is not a column of this model and friction set; identify and "
+                  "validate with the same robot and --friction options");
+    }
+    theta[it - columns.begin()] = values[static_cast<Eigen::Index>(i)];
+  }
+  const Eigen::MatrixXd W = stacked_regressor(
+      model, options.layout, options.coupling && !coupled_motors(model).empty(), r);
+  const Eigen::VectorXd pred = W * theta;
+  const Eigen::Index m = r.t.size();
+  out.samples = m;
+  out.predicted =
+      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+          pred.data(), m, n);
+  const Eigen::MatrixXd e = r.tau - out.predicted;
+  out.rms = (e.colwise().squaredNorm() / static_cast<double>(m)).cwiseSqrt().transpose();
+  out.relative_error =
+      (e.colwise().norm().array() / r.tau.colwise().norm().array().max(1e-300)).transpose();
+  out.relative_error_all = e.norm() / r.tau.norm();
+  return out;
+}
+
+}  // namespace dynid
