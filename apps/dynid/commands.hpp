@@ -1,0 +1,20 @@
+#pragma once
+
+// The dynid subcommands. Each file cmd_<name>.cpp registers one subcommand: parse -> validate ->
+// call the library -> write results. No math here (DESIGN.md section 2).
+
+#include <CLI/CLI.hpp>
+
+namespace dynid::cli {
+
+/// `dynid model`: robot summary and JSON export (cmd_model.cpp).
+void add_model_command(CLI::App& app);
+
+/// `dynid inverse-dynamics`: joint torques for every row of a states CSV
+/// (cmd_inverse_dynamics.cpp).
+void add_inverse_dynamics_command(CLI::App& app);
+
+/// `dynid demo`: built-in puma560 summary and a few inverse-dynamics results (cmd_demo.cpp).
+void add_demo_command(CLI::App& app);
+
+}  // namespace dynid::cli
