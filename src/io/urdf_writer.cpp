@@ -58,8 +58,10 @@ std::string to_urdf(const Model& model, const UrdfWriteOptions& options) {
     const LinkParams& p = model.links[j];
     const double m = p(9);
     out << "  <link name=\"" << link_name(j) << "\">\n";
-    if (m > 0.0) {
-      const Eigen::Vector3d c = p.segment<3>(6) / m;
+    if (m > 0.0 || !p.head<6>().isZero(0.0)) {
+      // A massless link can still carry rotational inertia (e.g. a rotor-only link 1).
+      const Eigen::Vector3d c =
+          m > 0.0 ? Eigen::Vector3d(p.segment<3>(6) / m) : Eigen::Vector3d::Zero();
       const Eigen::Matrix3d I_C =
           inertia_about_origin(p) -
           m * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());

@@ -16,7 +16,7 @@ struct UrdfWriteOptions {
 /// Writes the model as URDF text: one joint per Model joint (revolute with ±inf limits becomes
 /// continuous), origins as xyz/rpy, inertials about the centre of mass with the full tensor in the
 /// link frame (standard parameters converted back by the parallel-axis theorem), <dynamics damping
-/// friction> from Fv and Fc. Links with zero mass get a tiny placeholder inertia-free <inertial>.
+/// friction> from Fv and Fc. Massless links keep their rotational inertia.
 /// Round trip: load_urdf(to_urdf(model)) reproduces the dynamics (the loader merges nothing).
 std::string to_urdf(const Model& model, const UrdfWriteOptions& options = {});
 
