@@ -34,6 +34,7 @@ RecursiveLeastSquares::RecursiveLeastSquares(Eigen::Index parameters,
   f_.resize(parameters);
   v_.resize(parameters);
   k_.resize(parameters);
+  row_.resize(parameters);
 }
 
 void RecursiveLeastSquares::set_initial_estimate(const Eigen::Ref<const Eigen::VectorXd>& x0) {
@@ -104,7 +105,11 @@ void RecursiveLeastSquares::update(const Eigen::Ref<const Eigen::MatrixXd>& W,
                 std::to_string(W.rows()) + "; pass one observation per row of W");
   }
   if (options_.record_history) history_.reserve(history_.size() + W.rows() * parameters_);
-  for (Eigen::Index i = 0; i < W.rows(); ++i) update(W.row(i).transpose(), y(i));
+  // A row of a column-major W is strided; copy it into the workspace (no allocation per sample).
+  for (Eigen::Index i = 0; i < W.rows(); ++i) {
+    row_ = W.row(i).transpose();
+    update(row_, y(i));
+  }
 }
 
 Eigen::MatrixXd RecursiveLeastSquares::covariance_factor() const {

@@ -70,7 +70,7 @@ class RecursiveLeastSquares {
   Eigen::VectorXd x_;
   Eigen::MatrixXd u_;
   Eigen::VectorXd d_;
-  Eigen::VectorXd f_, v_, k_;  // workspace
+  Eigen::VectorXd f_, v_, k_, row_;  // workspace
   Eigen::Index samples_ = 0;
   double cost_ = 0.0;
   double effective_samples_ = 0.0;
