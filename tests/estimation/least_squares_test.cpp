@@ -358,6 +358,24 @@ TEST(Errors, EveryBadInputHasAOneLineMessage) {
   expect_error([&] { few.solve_ordinary(); }, {"2 rows for 3 parameters"});
 }
 
+TEST(WeightedLeastSquares, GroupWithoutDegreesOfFreedomUsesPooledVariance) {
+  std::mt19937 rng(22);
+  const Eigen::Index m = 60, p = 3;
+  const Eigen::MatrixXd W = gaussian(m, p, rng);
+  const Eigen::VectorXd y = W * Eigen::Vector3d(1, 2, 3) + gaussian(m, 1, rng, 0.1);
+  Eigen::VectorXi g = Eigen::VectorXi::Zero(m);
+  g.tail(2).setOnes();  // group 1: 2 rows for 3 parameters, no noise estimate of its own
+  const Estimate ols = ordinary_least_squares(W, y, g);
+  EXPECT_TRUE(std::isnan(ols.group_variance(1)));
+  const Estimate e = weighted_least_squares(W, y, g);
+  EXPECT_DOUBLE_EQ(e.group_variance(1), ols.residual_variance);
+  ASSERT_FALSE(e.summary.warnings.empty());
+  EXPECT_NE(e.summary.warnings.front().find("group 1 has too few rows"), std::string::npos);
+  const std::string report = e.summary.brief_report();
+  EXPECT_NE(report.find("weighted_least_squares: 60 rows, 3 parameters, rank 3"), std::string::npos)
+      << report;
+}
+
 TEST(OrdinaryLeastSquares, SquareSystemHasNoStatistics) {
   std::mt19937 rng(21);
   const Eigen::MatrixXd W = gaussian(3, 3, rng);

@@ -54,7 +54,8 @@ struct Summary {
 };
 
 /// Result of an estimator of y = W·x + e: the estimate, its uncertainty, residual statistics
-/// (Gautier) and a Summary. Group vectors are indexed by row group (joint); empty for RLS.
+/// (Gautier) and a Summary. Group vectors are indexed by row group (joint), NaN for a group
+/// without rows; empty for RLS.
 struct Estimate {
   Eigen::VectorXd x;           ///< estimate (p); minimum-norm solution if W is rank deficient
   Eigen::MatrixXd covariance;  ///< σ²·(WᵀW)⁻¹ (pseudo-inverse if rank deficient), p×p
