@@ -21,10 +21,13 @@ std::string read_whole_file(const std::string& path) {
   std::string text;
   if (std::fseek(file.get(), 0, SEEK_END) == 0) {
     const long size = std::ftell(file.get());
-    if (size > 0) text.reserve(static_cast<std::size_t>(size));
     std::rewind(file.get());
+    if (size > 0) {  // regular file: one read into place
+      text.resize(static_cast<std::size_t>(size));
+      text.resize(std::fread(text.data(), 1, text.size(), file.get()));
+    }
   }
-  char buffer[1 << 16];
+  char buffer[1 << 16];  // anything left (pipes, files that grew)
   std::size_t got = 0;
   while ((got = std::fread(buffer, 1, sizeof(buffer), file.get())) > 0) text.append(buffer, got);
   if (std::ferror(file.get())) {
@@ -81,12 +84,13 @@ CsvTable parse_csv(std::string_view text, const std::string& source) {
     if (nl == nullptr) break;
     q = nl + 1;
   }
-  table.data.resize(capacity, n);
+  // Rows are parsed into contiguous row-major storage (sequential writes), then transposed once.
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> buffer(capacity, n);
   table.lines.reserve(static_cast<std::size_t>(capacity));
   Eigen::Index rows = 0;
   while (next_line()) {
     if (is_skippable(b, e)) continue;
-    parse_row(b, e, table.columns, table.data.data() + rows, capacity, source, line,
+    parse_row(b, e, table.columns, buffer.data() + rows * n, 1, source, line,
               static_cast<long>(rows) + 1, !terminated);
     table.lines.push_back(line);
     ++rows;
@@ -94,7 +98,7 @@ CsvTable parse_csv(std::string_view text, const std::string& source) {
   if (rows == 0) {
     throw Error(source + ": header but no data rows; add one line of numbers per sample");
   }
-  if (rows != capacity) table.data = table.data.topRows(rows).eval();
+  table.data = buffer.topRows(rows);
   return table;
 }
 
