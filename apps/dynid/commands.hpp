@@ -17,4 +17,10 @@ void add_inverse_dynamics_command(CLI::App& app);
 /// `dynid demo`: built-in puma560 summary and a few inverse-dynamics results (cmd_demo.cpp).
 void add_demo_command(CLI::App& app);
 
+/// `dynid identify`: base parameters with uncertainty from a recorded run (cmd_identify.cpp).
+void add_identify_command(CLI::App& app);
+
+/// `dynid validate`: prediction errors of identified parameters on another run (cmd_identify.cpp).
+void add_validate_command(CLI::App& app);
+
 }  // namespace dynid::cli

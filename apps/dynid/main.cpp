@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
   app.fallthrough(false);
   dynid::cli::add_model_command(app);
   dynid::cli::add_inverse_dynamics_command(app);
+  dynid::cli::add_identify_command(app);
+  dynid::cli::add_validate_command(app);
   dynid::cli::add_demo_command(app);
   try {
     app.parse(argc, argv);

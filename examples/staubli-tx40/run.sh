@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Identifies the Staubli TX40 from the FIGAROH motor-side run (../shared/datasets/staubli-tx40).
+# Usage: examples/staubli-tx40/run.sh DATASET_DIR OUT_DIR   (writes OUT_DIR/result.json)
+# The data set has positions and torques in two header-only files sampled at 5 kHz (ts = 0.2 ms,
+# config/T40X_config.yaml): they are joined into one motor-side run (qm1..qm6, taum1..taum6) and
+# identified through the model's transmission (gear ratios and the coupled wrist).
+set -euo pipefail
+if [ $# -ne 2 ]; then
+  echo "usage: $0 DATASET_DIR OUT_DIR" >&2
+  exit 2
+fi
+data=$1
+out=$2
+here=$(cd "$(dirname "$0")" && pwd)
+dynid=${DYNID:-$here/../../build/dynid}
+for f in "$data/data/pos_read_data.csv" "$data/data/curr_data.csv"; do
+  [ -f "$f" ] || { echo "error: missing $f; give the staubli-tx40 data set folder" >&2; exit 1; }
+done
+mkdir -p "$out"
+run="$out/tx40_run.csv"
+{
+  echo "qm1,qm2,qm3,qm4,qm5,qm6,taum1,taum2,taum3,taum4,taum5,taum6"
+  paste -d, <(tail -n +2 "$data/data/pos_read_data.csv") <(tail -n +2 "$data/data/curr_data.csv")
+} > "$run.tmp"
+mv "$run.tmp" "$run"
+"$dynid" identify --robot "$here/tx40.yaml" --data "$run" --rate 5000 --out "$out/result.json"
