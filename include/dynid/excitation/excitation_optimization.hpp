@@ -56,6 +56,12 @@ struct ExcitationOptions {
   Eigen::Vector3d box_min = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
   Eigen::Vector3d box_max = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
 
+  /// Inside the optimisation every joint/torque limit is tightened by this fraction (position:
+  /// of the range) so that the peaks between the optimisation samples still meet the limits on
+  /// the fine check grid.
+  double grid_margin = 0.03;
+  double workspace_margin = 0.01;  ///< same for the workspace planes, in metres [m]
+
   int starts = 4;                      ///< multi-start: number of random initial points
   unsigned seed = 20261123;            ///< seed of the random initial points (deterministic runs)
   int max_evaluations = 3000;          ///< evaluation budget per start
@@ -95,8 +101,9 @@ struct ExcitationResult {
 /// box; bandwidth N·f0 ≤ f_max by construction. Multi-start NLopt from a fixed seed, keeping the
 /// best point that satisfies every constraint; the result is re-checked on a finer grid.
 /// Throws dynid::Error for invalid options (sizes, f0 ≤ 0, bandwidth above f_max, a joint with no
-/// finite position, velocity or acceleration limit to bound its coefficients) and when no start
-/// finds a feasible point (with the most violated constraint).
+/// finite position, velocity or acceleration limit to bound its coefficients). When no start finds
+/// a feasible point, the least-violating point is returned with constraints_satisfied = false
+/// (a numerical outcome, reported, not thrown).
 ExcitationResult optimize_excitation(const Model& model, const ExcitationOptions& options = {});
 
 /// Evaluation of a given trajectory under the options' criterion and constraints (the check that
