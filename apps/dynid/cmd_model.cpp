@@ -3,25 +3,44 @@
 #include <string>
 
 #include "commands.hpp"
+#include "dynid/common/error.hpp"
+#include "dynid/identifiability/base_parameters.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/io/model_summary.hpp"
 #include "dynid/model/robots.hpp"
+#include "dynid/report/identification_report.hpp"
 
 namespace dynid::cli {
 namespace {
 
 struct ModelOptions {
-  std::string robot;  // built-in name or .urdf/.yaml path
-  std::string json;   // optional JSON output path
-  // A later issue adds `--base` (base parameters and regrouping): add the flag here and a section
-  // to the text/JSON output in run_model.
+  std::string robot;              // built-in name or .urdf/.yaml path
+  std::string json;               // optional JSON output path
+  bool base = false;              // also compute the base parameters
+  std::string friction = "none";  // per-joint columns classified with the link parameters
 };
+
+ParameterLayout parse_layout(const std::string& text) {
+  if (text == "none") return ParameterLayout::rigid();
+  if (text == "full") return ParameterLayout::full();
+  throw UsageError(
+      "--friction for --base must be none (link parameters only) or full (with Ia, Fv, Fc, Fo)");
+}
 
 void run_model(const ModelOptions& options) {
   const Model model = load_robot(options.robot);
   std::cout << model_summary_text(model);
+  nlohmann::json json = model_to_json(model);
+  if (options.base) {
+    BaseParameterOptions base_options;
+    base_options.layout = parse_layout(options.friction);
+    base_options.coupling = true;
+    const BaseParameters base = compute_base_parameters(model, base_options);
+    std::cout << '\n' << base_parameters_text(base);
+    json.update(base_parameters_to_json(base));
+  }
   if (!options.json.empty()) {
-    write_json(options.json, model_to_json(model));
+    write_json(options.json, json);
     std::cout << "\nwrote " << options.json << '\n';
   }
 }
@@ -47,6 +66,13 @@ void add_model_command(CLI::App& app) {
   cmd->add_option("--json", options->json,
                   "Also write the model as JSON to this file (keys: name, source, dof, gravity, "
                   "joints, standard_parameters, friction, transmission, version)");
+  cmd->add_flag("--base", options->base,
+                "Also compute the base parameters (numerical Gautier-Khalil), their regrouping "
+                "expressions and the parameters with no effect; JSON keys base_parameters, "
+                "unidentifiable, rank");
+  cmd->add_option("--friction", options->friction,
+                  "With --base: none (link parameters only) or full (also Ia, Fv, Fc, Fo)")
+      ->capture_default_str();
   cmd->callback([options] { run_model(*options); });
 }
 

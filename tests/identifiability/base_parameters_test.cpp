@@ -4,6 +4,7 @@
 
 #include "dynid/common/error.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
+#include "dynid/model/robots.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
 #include "support/planar2.hpp"
 #include "support/random_models.hpp"
@@ -96,6 +97,20 @@ TEST(BaseParameters, NothingIdentifiableIsAnError) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("no parameter"), std::string::npos);
   }
+}
+
+}  // namespace
+}  // namespace dynid
+
+namespace dynid {
+namespace {
+
+// The PUMA 560 has 36 base inertial parameters (Khalil & Dombre, "Modeling, Identification and
+// Control of Robots", 2002, §9.10 / Gautier & Khalil 1990), independent of the numerical values.
+TEST(BaseParameters, Puma560HasThePublishedCount) {
+  const BaseParameters bp = compute_base_parameters(load_robot("puma560"));
+  EXPECT_EQ(bp.rank, 36);
+  EXPECT_EQ(bp.names.front(), "ZZ1R");
 }
 
 }  // namespace

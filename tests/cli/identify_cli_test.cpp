@@ -1,0 +1,121 @@
+// dynid model --base, identify and validate through the binary: keys of the JSON interfaces,
+// exit codes and error lines.
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+struct CliRun {
+  int code;
+  std::string err;
+};
+
+CliRun run(const std::string& args) {
+  const std::string err_path = ::testing::TempDir() + "/identify_cli_err.txt";
+  const std::string cmd = std::string(DYNID_BINARY) + " " + args + " > /dev/null 2> " + err_path;
+  const int status = std::system(cmd.c_str());
+  std::ifstream f(err_path);
+  std::string err((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  return {WEXITSTATUS(status), err};
+}
+
+nlohmann::json load(const std::string& path) {
+  return nlohmann::json::parse(std::ifstream(path));
+}
+
+TEST(IdentifyCli, ModelBaseWritesBaseParametersAndUnidentifiable) {
+  const std::string out = ::testing::TempDir() + "/planar2_base.json";
+  ASSERT_EQ(run("model --robot planar2 --base --json " + out).code, 0);
+  const auto j = load(out);
+  EXPECT_EQ(j["rank"], 6);
+  EXPECT_EQ(j["base_parameters"][0]["name"], "ZZ1R");
+  EXPECT_EQ(j["base_parameters"][0]["expression"], "ZZ1R = ZZ1 + M2");  // l1 = 1 m
+  EXPECT_EQ(j["unidentifiable"].size(), 13u);
+}
+
+// A planar2 run generated here from the closed form of docs/methods/model.md (not by dynid).
+std::string planar2_run() {
+  const std::string path = ::testing::TempDir() + "/planar2_run.csv";
+  std::ofstream f(path);
+  f << "t,q1,q2,dq1,dq2,ddq1,ddq2,tau1,tau2\n";
+  const double m1 = 2.0, m2 = 1.5, l1 = 1.0, c1 = 0.5, c2 = 0.4, I1 = 2.0 / 12,
+               I2 = 1.5 * 0.64 / 12, g = 9.81;
+  for (int k = 0; k < 2000; ++k) {
+    const double t = k * 0.01;
+    const double q1 = std::sin(0.7 * t) + 0.3 * std::sin(2.1 * t), q2 = 0.8 * std::cos(1.3 * t);
+    const double dq1 = 0.7 * std::cos(0.7 * t) + 0.63 * std::cos(2.1 * t),
+                 dq2 = -1.04 * std::sin(1.3 * t);
+    const double ddq1 = -0.49 * std::sin(0.7 * t) - 1.323 * std::sin(2.1 * t),
+                 ddq2 = -1.352 * std::cos(1.3 * t);
+    const double d11 =
+        m1 * c1 * c1 + m2 * (l1 * l1 + c2 * c2 + 2 * l1 * c2 * std::cos(q2)) + I1 + I2;
+    const double d12 = m2 * (c2 * c2 + l1 * c2 * std::cos(q2)) + I2, d22 = m2 * c2 * c2 + I2;
+    const double h = -m2 * l1 * c2 * std::sin(q2);
+    const double g1 = (m1 * c1 + m2 * l1) * g * std::cos(q1) + m2 * c2 * g * std::cos(q1 + q2);
+    const double g2 = m2 * c2 * g * std::cos(q1 + q2);
+    const double tau1 = d11 * ddq1 + d12 * ddq2 + h * dq2 * dq2 + 2 * h * dq1 * dq2 + g1;
+    const double tau2 = d12 * ddq1 + d22 * ddq2 - h * dq1 * dq1 + g2;
+    f << t << ',' << q1 << ',' << q2 << ',' << dq1 << ',' << dq2 << ',' << ddq1 << ',' << ddq2
+      << ',' << tau1 << ',' << tau2 << '\n';
+  }
+  return path;
+}
+
+TEST(IdentifyCli, IdentifyAndValidateWriteTheirInterfaces) {
+  const std::string data = planar2_run();
+  const std::string out = ::testing::TempDir() + "/planar2_result.json";
+  ASSERT_EQ(run("identify --robot planar2 --data " + data +
+                " --filter none --friction none "
+                "--no-armature --out " +
+                out)
+                .code,
+            0);
+  const auto j = load(out);
+  for (const char* key : {"parameters", "confidence_level", "rank", "condition_number", "samples",
+                          "residual_rms", "relative_error"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_EQ(j["rank"], 6);
+  for (const char* key : {"name", "value", "std", "relative_std_percent", "ci_low", "ci_high"}) {
+    EXPECT_TRUE(j["parameters"][0].contains(key)) << key;
+  }
+  // ZZ1R = ZZ1 + l1²·M2 of the closed-form arm: I1 + m1·c1² + m2·l1².
+  EXPECT_NEAR(j["parameters"][0]["value"].get<double>(), 2.0 / 12 + 2.0 * 0.25 + 1.5, 1e-4);
+  EXPECT_LT(j["relative_error"].get<double>(), 1e-4);
+  const std::string val = ::testing::TempDir() + "/planar2_val.json";
+  ASSERT_EQ(
+      run("validate --robot planar2 --params " + out + " --data " + data + " --json " + val).code,
+      0);
+  const auto v = load(val);
+  EXPECT_EQ(v["joints"].size(), 2u);
+  EXPECT_TRUE(v["joints"][0].contains("rms"));
+  EXPECT_LT(v["relative_error"].get<double>(), 1e-4);
+}
+
+TEST(IdentifyCli, BadInputsGiveOneErrorLineAndNoOutput) {
+  const std::string data = planar2_run();
+  const std::string out = ::testing::TempDir() + "/never_written.json";
+  std::filesystem::remove(out);
+  CliRun r = run("identify --robot planar2 --data " + data + " --estimator magic --out " + out);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "error: --estimator must be ols, wls or rls, not 'magic'\n");
+  r = run("identify --robot planar2 --data /no/such.csv --out " + out);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(r.err.rfind("error: ", 0), 0u);
+  EXPECT_NE(r.err.find("/no/such.csv"), std::string::npos);
+  r = run("identify --robot puma560 --data " + data + " --out " + out);  // 2 joints for 6
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("6"), std::string::npos);
+  r = run("validate --robot planar2 --params /no/result.json --data " + data);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("result.json"), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+}  // namespace
