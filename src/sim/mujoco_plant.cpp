@@ -1,6 +1,7 @@
 // MuJoCo plant: the model exported by to_urdf() and loaded from an in-memory VFS.
 #include <cmath>
 #include <cstring>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -37,7 +38,17 @@ class MujocoPlant final : public Plant {
         offset_(n_) {
     UrdfWriteOptions urdf_options;
     urdf_options.mujoco_compiler_tag = true;
-    const std::string urdf = to_urdf(model, urdf_options);
+    std::string urdf = to_urdf(model, urdf_options);
+    // MuJoCo refuses moving bodies without mass or inertia: add the compiler's floors.
+    const std::string tag = "angle=\"radian\"";
+    const std::size_t at = urdf.find(tag);
+    if (at != std::string::npos && (options.bound_mass > 0.0 || options.bound_inertia > 0.0)) {
+      std::ostringstream bounds;
+      bounds.precision(17);
+      bounds << " boundmass=\"" << options.bound_mass << "\" boundinertia=\""
+             << options.bound_inertia << "\"";
+      urdf.insert(at + tag.size(), bounds.str());
+    }
     const std::string file = "dynid_plant.urdf";
     std::unique_ptr<mjVFS, VfsDeleter> vfs(new mjVFS);
     mj_defaultVFS(vfs.get());

@@ -67,8 +67,11 @@ struct NativePlantOptions {
 struct MujocoPlantOptions {
   MujocoIntegrator integrator = MujocoIntegrator::kRk4;  ///< MuJoCo integrator; timestep = dt
   bool coulomb = true;  ///< Coulomb Fc as MuJoCo dof_frictionloss (its soft-constraint model)
-  bool enforce_limits =
-      false;  ///< keep MuJoCo's joint-limit constraints (the native plant has none)
+  bool enforce_limits = false;  ///< keep MuJoCo's joint-limit constraints (native has none)
+  double bound_mass = 1e-6;     ///< MJCF compiler boundmass [kg]: MuJoCo rejects massless
+                                ///< moving bodies (e.g. puma560 link1), masses get this floor
+  double bound_inertia = 1e-9;  ///< MJCF compiler boundinertia [kg·m²]: floor on the principal
+                                ///< inertias, for the same reason
 };
 
 /// Options of make_plant().
@@ -86,7 +89,8 @@ struct PlantOptions {
 /// MuJoCo: mj_loadXML on to_urdf(model, {.mujoco_compiler_tag = true}) from an in-memory VFS;
 /// joints matched by name; dof_armature = Ia, dof_damping = Fv, dof_frictionloss = Fc (when
 /// mujoco.coulomb), gravity = model.gravity, timestep = dt; contacts (and limits unless
-/// enforce_limits) disabled; Fo subtracted from the applied torque.
+/// enforce_limits) disabled; Fo subtracted from the applied torque; masses and principal inertias
+/// below bound_mass / bound_inertia raised to them (a massless link gains at most that much).
 /// Throws dynid::Error for a non-positive dt, bad friction options, or a model MuJoCo rejects.
 std::unique_ptr<Plant> make_plant(const Model& model, const PlantOptions& options = {});
 
