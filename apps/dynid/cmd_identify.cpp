@@ -8,6 +8,7 @@
 #include "dynid/common/error.hpp"
 #include "dynid/io/joint_record_file.hpp"
 #include "dynid/io/json_writer.hpp"
+#include "dynid/io/streaming_identification.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/report/identification_report.hpp"
 
@@ -24,6 +25,7 @@ struct IdentifyCliOptions {
   std::string estimator = "ols";
   std::vector<double> zero_velocity;
   bool savgol = false;
+  bool stream = false;
 };
 
 std::vector<std::string> split(const std::string& text, char sep) {
@@ -146,8 +148,9 @@ void run_identify(const IdentifyCliOptions& o) {
   RunFileOptions file;
   file.columns = parse_column_mapping(o.columns);
   file.rate_hz = o.rate;
-  const JointRecord record = read_joint_record(o.data, model, file);
-  const IdentificationResult result = identify(model, record, options);
+  const IdentificationResult result =
+      o.stream ? identify_stream(model, o.data, file, options)
+               : identify(model, read_joint_record(o.data, model, file), options);
   std::cout << identification_table(model, result);
   write_json(o.out, identification_to_json(model, result, echo(o)));
   std::cout << "wrote " << o.out << '\n';
@@ -207,6 +210,9 @@ void add_identify_command(CLI::App& app) {
                   "Drop rows of joint j with |dq_j| below this [rad/s] (1 or n values); "
                   "default 1 % of max|dq_j|")
       ->delimiter(',');
+  cmd->add_flag("--stream", o->stream,
+                "Constant-memory mode for very long runs: reads the file in chunks; needs q, dq, "
+                "ddq, tau columns and --filter none");
   add_signal_flags(cmd, *o);
   cmd->callback([o] { run_identify(*o); });
 }

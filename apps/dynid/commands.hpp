@@ -23,4 +23,7 @@ void add_identify_command(CLI::App& app);
 /// `dynid validate`: prediction errors of identified parameters on another run (cmd_identify.cpp).
 void add_validate_command(CLI::App& app);
 
+/// `dynid excite`: optimised Fourier excitation (cmd_excite.cpp).
+void add_excite_command(CLI::App& app);
+
 }  // namespace dynid::cli

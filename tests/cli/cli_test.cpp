@@ -271,12 +271,14 @@ TEST_F(Cli, BadInputsGiveOneErrorLineAndNoOutputFile) {
   EXPECT_EQ(work_entries(), 4);  // only the four inputs: no output or temporary file
 }
 
-TEST_F(Cli, DemoPrintsModelAndTorquesAndWritesFiles) {
-  const RunResult r = run("demo --out " + work("demo"));
+TEST_F(Cli, DemoRunsTheLoopAndWritesFiles) {
+  // Fewer periods than the default 25 keep the test short; the loop is the same.
+  const RunResult r = run("demo --periods 6 --out " + work("demo"));
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("robot      puma560"), std::string::npos);
-  EXPECT_NE(r.out.find("inverse dynamics"), std::string::npos);
-  for (const char* f : {"model.json", "states.csv", "torques.csv"}) {
+  EXPECT_NE(r.out.find("identified vs true base parameters"), std::string::npos);
+  EXPECT_NE(r.err.find("6/6 done"), std::string::npos);  // progress lines go to stderr
+  for (const char* f : {"traj.csv", "excitation.json", "run.csv", "averaged.csv", "result.json",
+                        "validation_run.csv", "validation.json"}) {
     EXPECT_TRUE(fs::exists(work("demo") + "/" + f)) << f;
   }
 }
