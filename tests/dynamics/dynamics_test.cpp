@@ -10,6 +10,7 @@
 #include "dynid/dynamics/rnea.hpp"
 #include "support/planar2.hpp"
 #include "support/random_models.hpp"
+#include "support/rk4.hpp"
 
 namespace dynid {
 namespace {
@@ -147,9 +148,8 @@ TEST(Energy, EnergyBalanceAlongSimulatedTrajectory) {
       kinetic_energy(model, ws, x.head(n), x.tail(n)) + potential_energy(model, ws, x.head(n));
   double t = 0.0;
   for (int k = 0; k < 1000; ++k) {
-    const Eigen::VectorXd k1 = deriv(t, x), k2 = deriv(t + dt / 2, x + dt / 2 * k1),
-                          k3 = deriv(t + dt / 2, x + dt / 2 * k2), k4 = deriv(t + dt, x + dt * k3);
-    const Eigen::VectorXd x_next = x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    Eigen::VectorXd k1;
+    const Eigen::VectorXd x_next = testing::rk4_step(deriv, t, x, dt, &k1);
     // Simpson's rule on the power; the midpoint state by cubic Hermite interpolation (O(dt⁴)).
     const Eigen::VectorXd x_mid = 0.5 * (x + x_next) + dt / 8 * (k1 - deriv(t + dt, x_next));
     work += dt / 6 * (power(t, x) + 4 * power(t + dt / 2, x_mid) + power(t + dt, x_next));

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/error_of.hpp"
 #include "dynid/common/error.hpp"
 
 namespace dynid::test {
@@ -43,20 +44,7 @@ class TempDir {
   std::filesystem::path path_;
 };
 
-/// Runs f, expects dynid::Error, and returns its message ("" and a test failure otherwise).
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected dynid::Error, got std::exception: " << e.what();
-    return "";
-  }
-  ADD_FAILURE() << "expected dynid::Error, nothing was thrown";
-  return "";
-}
+using dynid::testing::error_of;
 
 #define EXPECT_HAS(text, part)                               \
   EXPECT_NE(std::string(text).find(part), std::string::npos) \

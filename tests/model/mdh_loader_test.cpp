@@ -1,4 +1,5 @@
 #include "dynid/model/mdh_loader.hpp"
+#include "support/error_of.hpp"
 
 #include <cmath>
 #include <string>
@@ -13,19 +14,7 @@ namespace {
 
 const std::string kData = std::string(DYNID_SOURCE_DIR) + "/tests/data/models/";
 
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "non-dynid exception: " << e.what();
-    return {};
-  }
-  ADD_FAILURE() << "no exception thrown";
-  return {};
-}
+using dynid::testing::error_of;
 
 // Elementary homogeneous transforms written out element by element (independent of Eigen's
 // AngleAxis used by the loader).

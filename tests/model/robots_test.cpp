@@ -1,4 +1,5 @@
 #include "dynid/model/robots.hpp"
+#include "support/error_of.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -15,19 +16,7 @@ namespace {
 
 const std::string kData = std::string(DYNID_SOURCE_DIR) + "/tests/data/models/";
 
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "non-dynid exception: " << e.what();
-    return {};
-  }
-  ADD_FAILURE() << "no exception thrown";
-  return {};
-}
+using dynid::testing::error_of;
 
 std::vector<std::string> joint_names(const Model& m) {
   std::vector<std::string> v;

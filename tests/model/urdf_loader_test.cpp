@@ -1,4 +1,5 @@
 #include "dynid/model/urdf_loader.hpp"
+#include "support/error_of.hpp"
 
 #include <cmath>
 #include <limits>
@@ -18,19 +19,7 @@ const std::string kData = std::string(DYNID_SOURCE_DIR) + "/tests/data/models/";
 
 /// Runs f and returns the dynid::Error message (fails the test if nothing or something else is
 /// thrown).
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "non-dynid exception: " << e.what();
-    return {};
-  }
-  ADD_FAILURE() << "no exception thrown";
-  return {};
-}
+using dynid::testing::error_of;
 
 Eigen::Matrix3d rpy(double r, double p, double y) {
   // URDF: fixed-axis roll about x, then pitch about y, then yaw about z.

@@ -11,6 +11,7 @@
 #include "dynid/regressor/load_regressor.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
 #include "support/random_models.hpp"
+#include "support/rk4.hpp"
 
 namespace dynid {
 namespace {
@@ -125,10 +126,7 @@ TEST(IntegralRegressor, RowTimesThetaEqualsWorkAlongSimulation) {
     Q.row(k) = x.head(n).transpose();
     DQ.row(k) = x.tail(n).transpose();
     TAU.row(k) = torque(t[k]).transpose();
-    const Eigen::VectorXd k1 = deriv(t[k], x), k2 = deriv(t[k] + dt / 2, x + dt / 2 * k1),
-                          k3 = deriv(t[k] + dt / 2, x + dt / 2 * k2),
-                          k4 = deriv(t[k] + dt, x + dt * k3);
-    x += dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    x = testing::rk4_step(deriv, t[k], x, dt);
   }
   ParameterLayout layout = ParameterLayout::full();
   const Eigen::VectorXd theta = layout.parameters(model);

@@ -1,0 +1,27 @@
+#pragma once
+
+#include <exception>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "dynid/common/error.hpp"
+
+namespace dynid::testing {
+
+/// Runs f, expects dynid::Error, and returns its message ("" and a test failure otherwise).
+template <class F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected dynid::Error, got std::exception: " << e.what();
+    return "";
+  }
+  ADD_FAILURE() << "no exception thrown";
+  return "";
+}
+
+}  // namespace dynid::testing
