@@ -26,4 +26,7 @@ void add_validate_command(CLI::App& app);
 /// `dynid excite`: optimised Fourier excitation (cmd_excite.cpp).
 void add_excite_command(CLI::App& app);
 
+/// `dynid simulate`: closed-loop run of a reference on a simulated robot (cmd_simulate.cpp).
+void add_simulate_command(CLI::App& app);
+
 }  // namespace dynid::cli

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   dynid::cli::add_identify_command(app);
   dynid::cli::add_validate_command(app);
   dynid::cli::add_excite_command(app);
+  dynid::cli::add_simulate_command(app);
   dynid::cli::add_demo_command(app);
   try {
     app.parse(argc, argv);

@@ -5,7 +5,6 @@
 #include <sstream>
 
 #include "dynid/common/error.hpp"
-#include "dynid/dynamics/mass_matrix.hpp"
 #include "dynid/excitation/fourier_trajectory.hpp"
 #include "dynid/excitation/trajectory_samples.hpp"
 #include "dynid/excitation/trapezoidal_trajectory.hpp"
@@ -19,6 +18,7 @@
 #include "dynid/sim/pid_controller.hpp"
 #include "dynid/sim/plant.hpp"
 #include "dynid/sim/sensors.hpp"
+#include "dynid/sim/simulate_reference.hpp"
 
 namespace dynid {
 
@@ -36,23 +36,6 @@ void write_run(const std::string& path, const ClosedLoopResult& r) {
   Eigen::MatrixXd data(r.t.size(), 1 + 3 * n);
   data << r.t, r.qr, r.q, r.tau;
   write_csv(path, cols, data);
-}
-
-// Gains that give every joint about the same closed-loop bandwidth for its own inertia
-// (diagonal of M at the start pose): kp = M_jj·ω², kd = 2·ζ·M_jj·ω.
-PidOptions pid_for(const Model& model, const Eigen::VectorXd& q0, double rate) {
-  Workspace ws(model);
-  Eigen::MatrixXd M(model.dof(), model.dof());
-  mass_matrix(model, ws, q0, M);
-  const double w = 2 * M_PI * 8.0;  // 8 Hz position loop
-  PidOptions o;
-  o.kp = M.diagonal() * w * w;
-  o.kd = M.diagonal() * 2 * 0.9 * w;
-  o.ki = o.kp * 0.5;
-  o.sample_time = 1.0 / rate;
-  o.feed_forward = FeedForward::kComputedTorque;
-  o.effort_limit = Eigen::VectorXd::Constant(model.dof(), 1e6);
-  return o;
 }
 
 std::string line(const std::string& name, double truth, double value, double rel, bool inside) {
@@ -104,7 +87,7 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
   po.engine = o.mujoco ? PlantEngine::kMujoco : PlantEngine::kNative;
   po.dt = 1.0 / o.rate;
   auto plant = make_plant(model, po);
-  PidController pid(model, pid_for(model, traj.q.row(0).transpose(), o.rate));
+  PidController pid(model, default_pid_options(model, traj.q.row(0).transpose(), o.rate));
   SensorOptions so;
   so.counts_per_rev = 1 << 20;
   so.position_noise_std = o.position_noise;
@@ -167,7 +150,7 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
                                    Eigen::VectorXd::Constant(n, 3.0), 0.5);
   const TrajectorySamples mv = sample_trajectory(move, o.rate, true);
   auto plant2 = make_plant(model, po);
-  PidController pid2(model, pid_for(model, mv.q.row(0).transpose(), o.rate));
+  PidController pid2(model, default_pid_options(model, mv.q.row(0).transpose(), o.rate));
   so.seed = o.seed + 1;
   Sensors sensors2(model, so);
   co.periods = 1;

@@ -118,4 +118,42 @@ TEST(IdentifyCli, BadInputsGiveOneErrorLineAndNoOutput) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+// dynid excite writes t, q*, dq*, ddq* and its JSON keys; dynid simulate runs it and writes
+// t, qr*, q*, tau*; dynid identify accepts that run (issue 5 interfaces).
+TEST(IdentifyCli, ExciteSimulateIdentifyChain) {
+  const std::string dir = ::testing::TempDir();
+  ASSERT_EQ(run("excite -r planar2 --harmonics 3 --f0 0.2 --velocity-limit 2 "
+                "--acceleration-limit 8 --rate 200 --max-time 0 --starts 1 --max-evaluations 300 "
+                "-o " +
+                dir + "/traj.csv --json " + dir + "/ex.json")
+                .code,
+            0);
+  const auto ex = load(dir + "/ex.json");
+  for (const char* key : {"criterion", "value", "constraints_satisfied", "coefficients"}) {
+    EXPECT_TRUE(ex.contains(key)) << key;
+  }
+  std::ifstream traj(dir + "/traj.csv");
+  std::string header;
+  std::getline(traj, header);
+  EXPECT_EQ(header, "t,q1,q2,dq1,dq2,ddq1,ddq2");
+  ASSERT_EQ(run("simulate -r planar2 -t " + dir +
+                "/traj.csv --engine native --periods 3 "
+                "--torque-noise 0.05 -o " +
+                dir + "/run.csv")
+                .code,
+            0);
+  std::ifstream sim(dir + "/run.csv");
+  std::getline(sim, header);
+  EXPECT_EQ(header, "t,qr1,qr2,q1,q2,tau1,tau2");
+  ASSERT_EQ(
+      run("identify -r planar2 -d " + dir + "/run.csv --friction none -o " + dir + "/res.json")
+          .code,
+      0);
+  EXPECT_LT(load(dir + "/res.json")["relative_error"].get<double>(), 0.05);
+  const CliRun bad =
+      run("simulate -r planar2 -t " + dir + "/traj.csv --engine warp -o " + dir + "/x.csv");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_EQ(bad.err, "error: --engine must be mujoco or native, not 'warp'\n");
+}
+
 }  // namespace

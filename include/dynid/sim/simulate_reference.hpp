@@ -1,0 +1,35 @@
+#pragma once
+
+#include <Eigen/Core>
+
+#include "dynid/sim/closed_loop.hpp"
+#include "dynid/sim/pid_controller.hpp"
+#include "dynid/sim/plant.hpp"
+#include "dynid/sim/sensors.hpp"
+
+namespace dynid {
+
+/// PID gains that give every joint the same closed-loop bandwidth for its own inertia (diagonal
+/// of M(q0), actuator inertia included): kp = M_jj·ω², kd = 2ζ·M_jj·ω, ki = kp/2, ω = 2π·min(8 Hz, rate/40),
+/// ζ = 0.9, derivative filter ≥ 2 samples, with computed-torque feed-forward (seed 2 §3.6) and sample time 1/rate.
+PidOptions default_pid_options(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q0,
+                               double rate_hz);
+
+/// Options of simulate_reference().
+struct SimulateOptions {
+  PlantOptions plant;      ///< engine (native or MuJoCo); dt is set from the reference
+  SensorOptions sensors;   ///< quantisation, noise, delays
+  ClosedLoopOptions loop;  ///< periods (25), truth recording
+};
+
+/// Runs one periodic reference (t uniform, one period; a last sample equal to the first is the
+/// period's end and is dropped) in closed loop on the plant with default_pid_options() and
+/// returns the logged run (t, qr, q, tau, and the truth when asked). t: m, q/dq/ddq: m × n.
+/// Throws dynid::Error for a non-uniform or too short reference, or sizes that do not match.
+ClosedLoopResult simulate_reference(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& t,
+                                    const Eigen::Ref<const Eigen::MatrixXd>& q,
+                                    const Eigen::Ref<const Eigen::MatrixXd>& dq,
+                                    const Eigen::Ref<const Eigen::MatrixXd>& ddq,
+                                    SimulateOptions options);
+
+}  // namespace dynid

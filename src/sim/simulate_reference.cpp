@@ -1,0 +1,46 @@
+#include "dynid/sim/simulate_reference.hpp"
+
+#include <cmath>
+
+#include "dynid/common/error.hpp"
+#include "dynid/dynamics/mass_matrix.hpp"
+#include "dynid/signal/sampling_check.hpp"
+
+namespace dynid {
+
+PidOptions default_pid_options(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q0,
+                               double rate_hz) {
+  Workspace ws(model);
+  Eigen::MatrixXd M(model.dof(), model.dof());
+  mass_matrix(model, ws, q0, M);
+  // A discrete loop needs its bandwidth well below the sample rate (rate/40) and a derivative
+  // filter of at least two samples.
+  const double w = 2 * M_PI * std::min(8.0, rate_hz / 40.0);
+  PidOptions o;
+  o.kp = M.diagonal() * w * w;
+  o.kd = M.diagonal() * 2 * 0.9 * w;
+  o.ki = o.kp * 0.5;
+  o.sample_time = 1.0 / rate_hz;
+  o.derivative_filter_time = std::max(o.derivative_filter_time, 2.0 / rate_hz);
+  o.feed_forward = FeedForward::kComputedTorque;
+  o.effort_limit = Eigen::VectorXd::Constant(model.dof(), 1e6);
+  return o;
+}
+
+ClosedLoopResult simulate_reference(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& t,
+                                    const Eigen::Ref<const Eigen::MatrixXd>& q,
+                                    const Eigen::Ref<const Eigen::MatrixXd>& dq,
+                                    const Eigen::Ref<const Eigen::MatrixXd>& ddq,
+                                    SimulateOptions options) {
+  const SamplingInfo info = require_uniform_sampling(t, 1e-6, "closed-loop simulation");
+  Eigen::Index m = t.size();
+  if (m > 2 && (q.row(m - 1) - q.row(0)).norm() < 1e-9 * std::max(1.0, q.row(0).norm())) --m;
+  const Reference ref{t.head(m), q.topRows(m), dq.topRows(m), ddq.topRows(m)};
+  options.plant.dt = info.mean_period;
+  auto plant = make_plant(model, options.plant);
+  PidController pid(model, default_pid_options(model, q.row(0).transpose(), info.rate_hz()));
+  Sensors sensors(model, options.sensors);
+  return run_closed_loop(ref, pid, *plant, sensors, options.loop);
+}
+
+}  // namespace dynid
