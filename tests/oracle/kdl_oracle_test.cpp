@@ -10,6 +10,7 @@
 
 #include "dynid/dynamics/rnea.hpp"
 #include "dynid/io/urdf_writer.hpp"
+#include "dynid/model/robots.hpp"
 #include "oracle/oracle_support.hpp"
 #include "support/random_models.hpp"
 
@@ -86,6 +87,33 @@ TEST(KdlChainOracle, RneaMatchesChainIdSolver) {
     ASSERT_GE(solver.CartToJnt(kq, kdq, kddq, f_ext, ktau), 0);
     Eigen::VectorXd tau(7);
     rnea(model, ws, q, dq, ddq, tau);
+    EXPECT_LT((tau - ktau.data).norm() / ktau.data.norm(), testing::kOracleTolerance);
+  }
+}
+
+// The iiwa14 URDF file itself (Drake's parameters) read by kdl_parser and by dynid's loader.
+TEST(KdlChainOracle, Iiwa14UrdfFileMatchesChainIdSolver) {
+  const Model model = load_robot("iiwa14");
+  KDL::Tree tree;
+  ASSERT_TRUE(kdl_parser::treeFromFile(builtin_robots_dir() + "/iiwa14.urdf", tree));
+  KDL::Chain chain;
+  ASSERT_TRUE(tree.getChain(tree.getRootSegment()->first, model.joints.back().link_name, chain));
+  ASSERT_EQ(chain.getNrOfJoints(), 7u);
+  KDL::ChainIdSolver_RNE solver(
+      chain, KDL::Vector(model.gravity.x(), model.gravity.y(), model.gravity.z()));
+  Workspace ws(model);
+  std::mt19937 rng(14);
+  for (int k = 0; k < 20; ++k) {
+    const Eigen::VectorXd q = random_vector(7, rng, 2.0), dq = random_vector(7, rng, 2.0),
+                          ddq = random_vector(7, rng, 5.0);
+    KDL::JntArray kq(7), kdq(7), kddq(7), ktau(7);
+    kq.data = q;
+    kdq.data = dq;
+    kddq.data = ddq;
+    KDL::Wrenches f_ext(chain.getNrOfSegments(), KDL::Wrench::Zero());
+    ASSERT_GE(solver.CartToJnt(kq, kdq, kddq, f_ext, ktau), 0);
+    Eigen::VectorXd tau(7);
+    rnea(model, ws, q, dq, ddq, tau, RneaOptions{true, false});
     EXPECT_LT((tau - ktau.data).norm() / ktau.data.norm(), testing::kOracleTolerance);
   }
 }

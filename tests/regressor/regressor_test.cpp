@@ -7,6 +7,7 @@
 #include "dynid/dynamics/energy.hpp"
 #include "dynid/dynamics/mass_matrix.hpp"
 #include "dynid/dynamics/rnea.hpp"
+#include "dynid/model/robots.hpp"
 #include "dynid/regressor/energy_regressor.hpp"
 #include "dynid/regressor/load_regressor.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
@@ -69,6 +70,26 @@ INSTANTIATE_TEST_SUITE_P(Trees, RegressorOnTrees,
                          ::testing::Values(TreeCase{7, 1, false, true}, TreeCase{7, 2, true, true},
                                            TreeCase{9, 3, true, false}, TreeCase{6, 4, true, false},
                                            TreeCase{1, 5, false, true}));
+
+// Every built-in robot, with its own friction and armature values.
+TEST(TorqueRegressor, BuiltInRobotsMatchRnea) {
+  for (const auto& name : builtin_robot_names()) {
+    const Model model = load_robot(name);
+    const int n = model.dof();
+    Workspace ws(model);
+    const ParameterLayout layout = ParameterLayout::full();
+    Eigen::MatrixXd Y(n, layout.columns(n));
+    std::mt19937 rng(17);
+    for (int k = 0; k < 10; ++k) {
+      const Eigen::VectorXd q = random_vector(n, rng, 3.0), dq = random_vector(n, rng, 2.0),
+                            ddq = random_vector(n, rng, 5.0);
+      torque_regressor(model, ws, layout, q, dq, ddq, Y);
+      Eigen::VectorXd tau(n);
+      rnea(model, ws, q, dq, ddq, tau);
+      EXPECT_LT(rel_diff(Y * layout.parameters(model), tau), 1e-12) << name;
+    }
+  }
+}
 
 TEST(TorqueRegressor, AsymmetricFrictionColumnsFollowSeed2Eq2) {
   Model model = random_tree(4, 40, true);
