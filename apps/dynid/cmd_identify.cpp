@@ -11,6 +11,7 @@
 #include "dynid/io/streaming_identification.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/report/identification_report.hpp"
+#include "dynid/sim/simulate_reference.hpp"
 
 namespace dynid::cli {
 namespace {
@@ -157,13 +158,20 @@ void run_identify(const IdentifyCliOptions& o) {
 }
 
 struct ValidateCliOptions {
-  std::string robot, params, data, json, columns, mode = "torque";
+  std::string robot, params, data, json, columns, mode = "torque", trajectory, engine = "mujoco";
   double rate = 0.0;
 };
 
 void run_validate(const ValidateCliOptions& v) {
-  if (v.mode != "torque") {
-    throw UsageError("--mode '" + v.mode + "' is not available in this build; use --mode torque");
+  if (v.mode != "torque" && v.mode != "simulation") {
+    throw UsageError("--mode must be torque or simulation, not '" + v.mode + "'");
+  }
+  if (v.mode == "simulation" && v.trajectory.empty()) {
+    throw UsageError(
+        "--mode simulation needs --trajectory (the reference the measured run followed)");
+  }
+  if (v.engine != "mujoco" && v.engine != "native") {
+    throw UsageError("--engine must be mujoco or native, not '" + v.engine + "'");
   }
   const Model model = load_robot(v.robot);
   std::vector<std::string> names;
@@ -182,6 +190,20 @@ void run_validate(const ValidateCliOptions& v) {
   file.columns = parse_column_mapping(v.columns);
   file.rate_hz = v.rate;
   const JointRecord record = read_joint_record(v.data, model, file);
+  if (v.mode == "simulation") {
+    const JointRecord ref = read_reference(v.trajectory, model, file);
+    PlantOptions plant;
+    plant.engine = v.engine == "mujoco" ? PlantEngine::kMujoco : PlantEngine::kNative;
+    const SimulationValidation sv =
+        validate_run_by_simulation(identified_model(model, names, values, options), ref.t, ref.q,
+                                   ref.dq, ref.ddq, record.q, record.tau, plant);
+    std::cout << simulation_validation_table(model, sv);
+    if (!v.json.empty()) {
+      write_json(v.json, simulation_validation_to_json(model, sv));
+      std::cout << "wrote " << v.json << '\n';
+    }
+    return;
+  }
   const ValidationResult result = validate_torques(model, record, names, values, options);
   std::cout << validation_table(model, result);
   if (!v.json.empty()) {
@@ -226,7 +248,14 @@ void add_validate_command(CLI::App& app) {
   cmd->add_option("--params,-p", v->params, "result.json written by dynid identify")->required();
   cmd->add_option("--data,-d", v->data, "Run CSV to predict (same format as identify)")->required();
   cmd->add_option("--json", v->json, "Write the per-joint errors as JSON");
-  cmd->add_option("--mode", v->mode, "torque (predict measured torques)")->capture_default_str();
+  cmd->add_option("--mode", v->mode,
+                  "torque (predict the measured torques) or simulation (simulate the identified "
+                  "model under the same reference and controller, seed 2 §3.5)")
+      ->capture_default_str();
+  cmd->add_option("--trajectory", v->trajectory,
+                  "With --mode simulation: the reference CSV of the run");
+  cmd->add_option("--engine", v->engine, "With --mode simulation: mujoco or native")
+      ->capture_default_str();
   cmd->add_option("--rate", v->rate, "Sample rate [Hz] when the file has no t column");
   cmd->add_option("--columns", v->columns, "Rename columns before lookup: from=to,from2=to2");
   cmd->callback([v] { run_validate(*v); });

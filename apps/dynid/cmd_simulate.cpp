@@ -5,11 +5,9 @@
 
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
-#include "dynid/io/csv_reader.hpp"
 #include "dynid/io/csv_writer.hpp"
-#include "dynid/io/joint_columns.hpp"
+#include "dynid/io/joint_record_file.hpp"
 #include "dynid/model/robots.hpp"
-#include "dynid/signal/differentiation.hpp"
 #include "dynid/sim/simulate_reference.hpp"
 
 namespace dynid::cli {
@@ -29,20 +27,7 @@ void run(const SimulateCliOptions& o) {
   }
   if (o.periods < 1) throw UsageError("--periods must be >= 1");
   const Model model = load_robot(o.robot);
-  const CsvTable table = read_csv(o.trajectory);
-  const auto t_col = checked_time_column(table);
-  if (!t_col)
-    throw Error("'" + o.trajectory + "' has no time column 't'; write it with dynid excite");
-  std::vector<std::string> names;
-  for (const Joint& j : model.joints) names.push_back(j.name);
-  const Eigen::VectorXd t = table.data.col(*t_col);
-  const Eigen::MatrixXd q = joint_signal(table, names, "q");
-  const Eigen::MatrixXd dq = has_joint_columns(table.columns, names, "dq")
-                                 ? joint_signal(table, names, "dq")
-                                 : central_difference(t, q, 1);
-  const Eigen::MatrixXd ddq = has_joint_columns(table.columns, names, "ddq")
-                                  ? joint_signal(table, names, "ddq")
-                                  : central_difference(t, dq, 1);
+  const JointRecord ref = read_reference(o.trajectory, model);
   SimulateOptions s;
   s.plant.engine = o.engine == "mujoco" ? PlantEngine::kMujoco : PlantEngine::kNative;
   s.sensors.position_noise_std = o.position_noise;
@@ -52,7 +37,7 @@ void run(const SimulateCliOptions& o) {
   s.sensors.seed = o.seed;
   s.loop.periods = o.periods;
   s.loop.record_truth = o.truth;
-  const ClosedLoopResult r = simulate_reference(model, t, q, dq, ddq, s);
+  const ClosedLoopResult r = simulate_reference(model, ref.t, ref.q, ref.dq, ref.ddq, s);
   const Eigen::Index n = model.dof();
   std::vector<std::string> cols = {"t"};
   std::vector<const char*> prefixes = {"qr", "q", "tau"};

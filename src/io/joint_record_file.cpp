@@ -3,6 +3,7 @@
 #include "dynid/common/error.hpp"
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/model/transmission.hpp"
+#include "dynid/signal/differentiation.hpp"
 
 namespace dynid {
 
@@ -42,6 +43,25 @@ JointRecord read_joint_record(const std::string& path, const Model& model,
                     : joint_signal(table, names, "tau");
   if (has("dq")) r.dq = joint_signal(table, names, "dq");
   if (has("ddq")) r.ddq = joint_signal(table, names, "ddq");
+  return r;
+}
+
+JointRecord read_reference(const std::string& path, const Model& model,
+                           const RunFileOptions& options) {
+  CsvTable table = read_csv(path);
+  apply_column_mapping(table, options.columns);
+  const auto t = checked_time_column(table);
+  if (!t)
+    throw Error("'" + path + "' has no time column 't'; write the reference with dynid excite");
+  std::vector<std::string> names;
+  for (const Joint& j : model.joints) names.push_back(j.name);
+  JointRecord r;
+  r.t = table.data.col(*t);
+  r.q = joint_signal(table, names, "q");
+  r.dq = has_joint_columns(table.columns, names, "dq") ? joint_signal(table, names, "dq")
+                                                       : central_difference(r.t, r.q, 1);
+  r.ddq = has_joint_columns(table.columns, names, "ddq") ? joint_signal(table, names, "ddq")
+                                                         : central_difference(r.t, r.dq, 1);
   return r;
 }
 

@@ -173,4 +173,44 @@ std::string validation_table(const Model& model, const ValidationResult& v) {
   return s.str();
 }
 
+namespace {
+
+nlohmann::json statistics_json(const ErrorStatistics& e) {
+  return {{"rms", json_number(e.rms)},
+          {"max", json_number(e.max_abs)},
+          {"mean", json_number(e.mean)},
+          {"std", json_number(e.std)},
+          {"skewness", json_number(e.skewness)},
+          {"kurtosis", json_number(e.kurtosis)},
+          {"ks_statistic", json_number(e.ks_statistic)},
+          {"ks_p_value", json_number(e.ks_p_value)}};
+}
+
+}  // namespace
+
+nlohmann::json simulation_validation_to_json(const Model& model, const SimulationValidation& v) {
+  nlohmann::json joints = nlohmann::json::array();
+  for (int j = 0; j < model.dof(); ++j) {
+    joints.push_back({{"name", model.joints[j].name},
+                      {"position", statistics_json(v.position[j])},
+                      {"torque", statistics_json(v.torque[j])}});
+  }
+  return {{"mode", "simulation"},
+          {"joints", joints},
+          {"samples", v.position.empty() ? 0 : v.position[0].samples},
+          {"version", kVersion}};
+}
+
+std::string simulation_validation_table(const Model& model, const SimulationValidation& v) {
+  std::ostringstream s;
+  s << "validation by simulation (errors measured - simulated, after the first period)\n";
+  for (int j = 0; j < model.dof(); ++j) {
+    s << line(
+        "  %-12s position RMS %.4g max %.4g | torque RMS %.4g max %.4g, kurtosis %.3g, KS p %.3g\n",
+        model.joints[j].name.c_str(), v.position[j].rms, v.position[j].max_abs, v.torque[j].rms,
+        v.torque[j].max_abs, v.torque[j].kurtosis, v.torque[j].ks_p_value);
+  }
+  return s.str();
+}
+
 }  // namespace dynid

@@ -150,6 +150,20 @@ TEST(IdentifyCli, ExciteSimulateIdentifyChain) {
           .code,
       0);
   EXPECT_LT(load(dir + "/res.json")["relative_error"].get<double>(), 0.05);
+  // Validation by simulation (seed 2 §3.5): the identified model under the same reference and
+  // controller leaves only the torque sensor noise (σ = 0.05 N·m). Its RMS over the 2000 samples
+  // after the first period has a relative standard deviation of about 1/sqrt(2·2000) = 1.6 %; the
+  // band is ±20 % to also allow for the small identification error.
+  ASSERT_EQ(
+      run("validate --mode simulation -r planar2 -p " + dir + "/res.json -d " + dir +
+          "/run.csv --trajectory " + dir + "/traj.csv --engine native --json " + dir + "/vs.json")
+          .code,
+      0);
+  const auto vs = load(dir + "/vs.json");
+  for (int j = 0; j < 2; ++j) {
+    EXPECT_NEAR(vs["joints"][j]["torque"]["rms"].get<double>(), 0.05, 0.01) << j;
+    EXPECT_LT(vs["joints"][j]["position"]["rms"].get<double>(), 1e-4) << j;
+  }
   const CliRun bad =
       run("simulate -r planar2 -t " + dir + "/traj.csv --engine warp -o " + dir + "/x.csv");
   EXPECT_EQ(bad.code, 2);

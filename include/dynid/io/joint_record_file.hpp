@@ -23,4 +23,10 @@ struct RunFileOptions {
 JointRecord read_joint_record(const std::string& path, const Model& model,
                               const RunFileOptions& options = {});
 
+/// Reads a reference trajectory (`t`, `q*`, optional `dq*`, `ddq*`, e.g. from dynid excite) into
+/// a record with an empty tau; missing derivatives are central differences on the time stamps.
+/// Throws dynid::Error naming the file for a missing `t` or q columns.
+JointRecord read_reference(const std::string& path, const Model& model,
+                           const RunFileOptions& options = {});
+
 }  // namespace dynid

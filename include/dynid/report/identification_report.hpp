@@ -7,6 +7,7 @@
 #include "dynid/estimation/identification.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
 #include "dynid/model/model.hpp"
+#include "dynid/sim/simulation_validation.hpp"
 
 namespace dynid {
 
@@ -35,5 +36,10 @@ std::string base_parameters_text(const BaseParameters& base);
 /// `dynid validate` JSON: `joints` (name, rms, relative_error), `relative_error`, `samples`.
 nlohmann::json validation_to_json(const Model& model, const ValidationResult& v);
 std::string validation_table(const Model& model, const ValidationResult& v);
+
+/// `dynid validate --mode simulation` JSON: `joints` (name, position {rms, max, mean, std,
+/// skewness, kurtosis, ks_statistic, ks_p_value}, torque {same}), `samples`, `version`.
+nlohmann::json simulation_validation_to_json(const Model& model, const SimulationValidation& v);
+std::string simulation_validation_table(const Model& model, const SimulationValidation& v);
 
 }  // namespace dynid

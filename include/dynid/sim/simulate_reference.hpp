@@ -6,12 +6,14 @@
 #include "dynid/sim/pid_controller.hpp"
 #include "dynid/sim/plant.hpp"
 #include "dynid/sim/sensors.hpp"
+#include "dynid/sim/simulation_validation.hpp"
 
 namespace dynid {
 
 /// PID gains that give every joint the same closed-loop bandwidth for its own inertia (diagonal
-/// of M(q0), actuator inertia included): kp = M_jj·ω², kd = 2ζ·M_jj·ω, ki = kp/2, ω = 2π·min(8 Hz, rate/40),
-/// ζ = 0.9, derivative filter ≥ 2 samples, with computed-torque feed-forward (seed 2 §3.6) and sample time 1/rate.
+/// of M(q0), actuator inertia included): kp = M_jj·ω², kd = 2ζ·M_jj·ω, ki = kp/2, ω = 2π·min(8 Hz,
+/// rate/40), ζ = 0.9, derivative filter ≥ 2 samples, with computed-torque feed-forward (seed 2
+/// §3.6) and sample time 1/rate.
 PidOptions default_pid_options(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q0,
                                double rate_hz);
 
@@ -31,5 +33,16 @@ ClosedLoopResult simulate_reference(const Model& model, const Eigen::Ref<const E
                                     const Eigen::Ref<const Eigen::MatrixXd>& dq,
                                     const Eigen::Ref<const Eigen::MatrixXd>& ddq,
                                     SimulateOptions options);
+
+/// Validation by simulation (seed 2 §3.5) of a measured run made with simulate_reference()'s
+/// controller: simulates `identified` under the same reference (one period, as for
+/// simulate_reference) and default_pid_options(), and compares with q_measured, tau_measured
+/// (N×n from t_0 of the reference at its rate). The first period is left out of the statistics.
+SimulationValidation validate_run_by_simulation(
+    const Model& identified, const Eigen::Ref<const Eigen::VectorXd>& t,
+    const Eigen::Ref<const Eigen::MatrixXd>& q, const Eigen::Ref<const Eigen::MatrixXd>& dq,
+    const Eigen::Ref<const Eigen::MatrixXd>& ddq,
+    const Eigen::Ref<const Eigen::MatrixXd>& q_measured,
+    const Eigen::Ref<const Eigen::MatrixXd>& tau_measured, const PlantOptions& plant);
 
 }  // namespace dynid
