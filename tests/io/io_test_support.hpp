@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
-#include "support/error_of.hpp"
 #include "dynid/common/error.hpp"
+#include "support/error_of.hpp"
 
 namespace dynid::test {
 

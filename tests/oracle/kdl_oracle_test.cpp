@@ -65,6 +65,30 @@ TEST_P(KdlTreeOracle, RneaMatchesTreeIdSolver) {
 
 INSTANTIATE_TEST_SUITE_P(RandomTrees, KdlTreeOracle, ::testing::Values(1u, 2u, 3u, 4u));
 
+// RNEA (rigid body) against ChainIdSolver_RNE on 20 random states.
+void expect_chain_matches(const Model& model, const KDL::Chain& chain, unsigned seed) {
+  const int n = model.dof();
+  ASSERT_EQ(chain.getNrOfJoints(), static_cast<unsigned>(n));
+  KDL::ChainIdSolver_RNE solver(
+      chain, KDL::Vector(model.gravity.x(), model.gravity.y(), model.gravity.z()));
+  Workspace ws(model);
+  std::mt19937 rng(seed);
+  for (int k = 0; k < 20; ++k) {
+    const Eigen::VectorXd q = random_vector(n, rng, 3.0), dq = random_vector(n, rng, 2.0),
+                          ddq = random_vector(n, rng, 5.0);
+    KDL::JntArray kq(n), kdq(n), kddq(n), ktau(n);
+    kq.data = q;
+    kdq.data = dq;
+    kddq.data = ddq;
+    KDL::Wrenches f_ext(chain.getNrOfSegments(), KDL::Wrench::Zero());
+    ASSERT_GE(solver.CartToJnt(kq, kdq, kddq, f_ext, ktau), 0);
+    Eigen::VectorXd tau(n);
+    rnea(model, ws, q, dq, ddq, tau, RneaOptions{true, false});
+    EXPECT_LT((tau - ktau.data).norm() / ktau.data.norm(), testing::kOracleTolerance)
+        << "state " << k;
+  }
+}
+
 TEST(KdlChainOracle, RneaMatchesChainIdSolver) {
   Model model = random_tree(7, 77, true, true);
   for (auto& j : model.joints) j.friction = {};
@@ -72,23 +96,7 @@ TEST(KdlChainOracle, RneaMatchesChainIdSolver) {
   ASSERT_TRUE(kdl_parser::treeFromString(to_urdf(model), tree));
   KDL::Chain chain;
   ASSERT_TRUE(tree.getChain("base_link", model.joints.back().link_name, chain));
-  KDL::ChainIdSolver_RNE solver(
-      chain, KDL::Vector(model.gravity.x(), model.gravity.y(), model.gravity.z()));
-  Workspace ws(model);
-  std::mt19937 rng(77);
-  for (int k = 0; k < 20; ++k) {
-    const Eigen::VectorXd q = random_vector(7, rng, 3.0), dq = random_vector(7, rng, 2.0),
-                          ddq = random_vector(7, rng, 5.0);
-    KDL::JntArray kq(7), kdq(7), kddq(7), ktau(7);
-    kq.data = q;
-    kdq.data = dq;
-    kddq.data = ddq;
-    KDL::Wrenches f_ext(chain.getNrOfSegments(), KDL::Wrench::Zero());
-    ASSERT_GE(solver.CartToJnt(kq, kdq, kddq, f_ext, ktau), 0);
-    Eigen::VectorXd tau(7);
-    rnea(model, ws, q, dq, ddq, tau);
-    EXPECT_LT((tau - ktau.data).norm() / ktau.data.norm(), testing::kOracleTolerance);
-  }
+  expect_chain_matches(model, chain, 77);
 }
 
 // The iiwa14 URDF file itself (Drake's parameters) read by kdl_parser and by dynid's loader.
@@ -98,24 +106,7 @@ TEST(KdlChainOracle, Iiwa14UrdfFileMatchesChainIdSolver) {
   ASSERT_TRUE(kdl_parser::treeFromFile(builtin_robots_dir() + "/iiwa14.urdf", tree));
   KDL::Chain chain;
   ASSERT_TRUE(tree.getChain(tree.getRootSegment()->first, model.joints.back().link_name, chain));
-  ASSERT_EQ(chain.getNrOfJoints(), 7u);
-  KDL::ChainIdSolver_RNE solver(
-      chain, KDL::Vector(model.gravity.x(), model.gravity.y(), model.gravity.z()));
-  Workspace ws(model);
-  std::mt19937 rng(14);
-  for (int k = 0; k < 20; ++k) {
-    const Eigen::VectorXd q = random_vector(7, rng, 2.0), dq = random_vector(7, rng, 2.0),
-                          ddq = random_vector(7, rng, 5.0);
-    KDL::JntArray kq(7), kdq(7), kddq(7), ktau(7);
-    kq.data = q;
-    kdq.data = dq;
-    kddq.data = ddq;
-    KDL::Wrenches f_ext(chain.getNrOfSegments(), KDL::Wrench::Zero());
-    ASSERT_GE(solver.CartToJnt(kq, kdq, kddq, f_ext, ktau), 0);
-    Eigen::VectorXd tau(7);
-    rnea(model, ws, q, dq, ddq, tau, RneaOptions{true, false});
-    EXPECT_LT((tau - ktau.data).norm() / ktau.data.norm(), testing::kOracleTolerance);
-  }
+  expect_chain_matches(model, chain, 14);
 }
 
 }  // namespace
