@@ -94,14 +94,15 @@ ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& option
   if (options.filter && !info.uniform) {
     // Zero-phase filtering assumes uniform steps: resample first at the mean rate.
     const double rate = info.rate_hz();
-    Eigen::MatrixXd all(r.t.size(), 0);
+    Eigen::VectorXd t_new;
     auto resample = [&](Eigen::MatrixXd& x) {
       if (x.size() == 0) return;
       ResampleOptions ro;
-      ro.anti_alias.enabled = false;
-      x = resample_uniform(input.t, x, rate, ro).x;
+      ro.anti_alias.enabled = false;  // same rate: interpolation only
+      UniformRecord u = resample_uniform(input.t, x, rate, ro);
+      x = std::move(u.x);
+      t_new = std::move(u.t);
     };
-    Eigen::VectorXd t_new = resample_uniform(input.t, input.q, rate, {}).t;
     resample(r.q);
     resample(r.dq);
     resample(r.ddq);
