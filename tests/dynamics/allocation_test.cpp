@@ -17,6 +17,11 @@ namespace {
 std::atomic<long> g_allocations{0};
 }  // namespace
 
+// AddressSanitizer replaces operator new itself, so the count is only taken without it.
+#if defined(__SANITIZE_ADDRESS__)
+#define DYNID_COUNT_ALLOCATIONS 0
+#else
+#define DYNID_COUNT_ALLOCATIONS 1
 void* operator new(std::size_t size) {
   ++g_allocations;
   if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
@@ -28,6 +33,7 @@ void operator delete(void* p) noexcept {
 void operator delete(void* p, std::size_t) noexcept {
   std::free(p);
 }
+#endif
 
 namespace dynid {
 namespace {
