@@ -245,7 +245,6 @@ class Evaluator {
     Y_.resize(n, cols_);
     YbT_.resize(p_, n);
     A_.resize(p_, p_);
-    es_ = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(p_);
     tmp_a_.resize(n_max);
     tmp_b_.resize(n_max);
     worst_.resize(static_cast<Eigen::Index>(groups_.size()));
