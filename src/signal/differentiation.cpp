@@ -9,18 +9,7 @@
 
 namespace dynid {
 
-namespace {
-
-void check_sizes(const char* what, const Eigen::Ref<const Eigen::VectorXd>& t,
-                 const Eigen::Ref<const Eigen::MatrixXd>& x) {
-  if (t.size() != x.rows()) {
-    throw Error(std::string(what) + ": time vector has " + std::to_string(t.size()) +
-                " samples but the data has " + std::to_string(x.rows()) +
-                " rows: give one time stamp per row");
-  }
-}
-
-}  // namespace
+namespace {}  // namespace
 
 Eigen::MatrixXd central_difference(const Eigen::Ref<const Eigen::VectorXd>& t,
                                    const Eigen::Ref<const Eigen::MatrixXd>& x, int derivative) {
@@ -28,7 +17,7 @@ Eigen::MatrixXd central_difference(const Eigen::Ref<const Eigen::VectorXd>& t,
     throw Error("central difference derivative is " + std::to_string(derivative) +
                 ": give 1 (velocity) or 2 (acceleration)");
   }
-  check_sizes("central difference", t, x);
+  check_time_rows("central difference", t, x);
   const Eigen::Index m = t.size();
   if (m < 3) {
     throw Error("central difference needs at least 3 samples, got " + std::to_string(m) +
@@ -72,7 +61,7 @@ Eigen::MatrixXd savitzky_golay(const Eigen::Ref<const Eigen::VectorXd>& t,
     throw Error("Savitzky-Golay derivative is " + std::to_string(d) +
                 ": give 0, 1 or 2, at most the polynomial order " + std::to_string(p));
   }
-  check_sizes("Savitzky-Golay", t, x);
+  check_time_rows("Savitzky-Golay", t, x);
   const Eigen::Index m = t.size();
   if (m < w) {
     throw Error("Savitzky-Golay window of " + std::to_string(w) + " samples exceeds the " +

@@ -14,15 +14,6 @@ namespace dynid {
 
 namespace {
 
-void check_sizes(const char* what, const Eigen::Ref<const Eigen::VectorXd>& t,
-                 const Eigen::Ref<const Eigen::MatrixXd>& x) {
-  if (t.size() != x.rows()) {
-    throw Error(std::string(what) + ": time vector has " + std::to_string(t.size()) +
-                " samples but the data has " + std::to_string(x.rows()) +
-                " rows: give one time stamp per row");
-  }
-}
-
 // Second derivatives M (m × n) of the natural cubic spline through (t, x): tridiagonal system
 // h_{i−1}M_{i−1} + 2(h_{i−1}+h_i)M_i + h_i M_{i+1} = 6(Δ_i − Δ_{i−1}), M_0 = M_{m−1} = 0,
 // solved by the Thomas algorithm for all columns at once.
@@ -67,7 +58,7 @@ LowpassOptions anti_alias_design(const AntiAliasOptions& a, double new_rate, dou
 Eigen::MatrixXd interpolate(const Eigen::Ref<const Eigen::VectorXd>& t,
                             const Eigen::Ref<const Eigen::MatrixXd>& x,
                             const Eigen::Ref<const Eigen::VectorXd>& tq, Interpolation method) {
-  check_sizes("interpolation", t, x);
+  check_time_rows("interpolation", t, x);
   check_sampling(t);
   const Eigen::Index m = t.size();
   for (Eigen::Index q = 0; q < tq.size(); ++q) {
@@ -102,7 +93,7 @@ UniformRecord decimate(const Eigen::Ref<const Eigen::VectorXd>& t,
     throw Error("decimation factor is " + std::to_string(factor) +
                 ": give an integer factor of at least 1");
   }
-  check_sizes("decimation", t, x);
+  check_time_rows("decimation", t, x);
   const SamplingInfo info = require_uniform_sampling(t, uniform_tolerance, "decimation");
   Eigen::MatrixXd filtered;
   if (factor > 1 && anti_alias.enabled) {
@@ -130,7 +121,7 @@ UniformRecord resample_uniform(const Eigen::Ref<const Eigen::VectorXd>& t,
     msg << "resampling rate is " << rate_hz << " Hz: give a positive target sample rate";
     throw Error(msg.str());
   }
-  check_sizes("resampling", t, x);
+  check_time_rows("resampling", t, x);
   const SamplingInfo info = check_sampling(t);
   const Eigen::Index m = t.size();
   UniformRecord out;

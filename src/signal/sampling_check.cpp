@@ -51,4 +51,13 @@ SamplingInfo require_uniform_sampling(const Eigen::Ref<const Eigen::VectorXd>& t
   return info;
 }
 
+void check_time_rows(const char* what, const Eigen::Ref<const Eigen::VectorXd>& t,
+                     const Eigen::Ref<const Eigen::MatrixXd>& x) {
+  if (t.size() != x.rows()) {
+    throw Error(std::string(what) + ": time vector has " + std::to_string(t.size()) +
+                " samples but the data has " + std::to_string(x.rows()) +
+                " rows: give one time stamp per row");
+  }
+}
+
 }  // namespace dynid

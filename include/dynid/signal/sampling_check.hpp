@@ -24,4 +24,9 @@ SamplingInfo check_sampling(const Eigen::Ref<const Eigen::VectorXd>& t,
 SamplingInfo require_uniform_sampling(const Eigen::Ref<const Eigen::VectorXd>& t,
                                       double relative_tolerance, const char* what);
 
+/// Checks that x (m × n) has one row per time stamp of t (size m); `what` names the caller.
+/// Throws dynid::Error otherwise.
+void check_time_rows(const char* what, const Eigen::Ref<const Eigen::VectorXd>& t,
+                     const Eigen::Ref<const Eigen::MatrixXd>& x);
+
 }  // namespace dynid
