@@ -1,7 +1,7 @@
 // End-to-end identification throughput (CSV file → result) of the 7-DoF iiwa14 in streaming mode,
 // and its peak memory, for 10⁵ and 10⁶ samples (issue 4 item 7). The run file is generated once
 // per size in the temporary folder (joint-side t, q, dq, ddq, tau; torques from rnea + noise).
-// Run: ./build/bench/identification_bench --benchmark_repetitions=1
+// Run: ./build/bench/identification_bench
 #include <sys/resource.h>
 
 #include <cstdio>
@@ -64,8 +64,9 @@ void BM_IdentifyStream(benchmark::State& st) {
   const std::string path = run_file(model, samples);
   dynid::IdentifyOptions o;
   o.signal.filter = false;
+  const dynid::StreamingIdentificationOptions so{static_cast<int>(st.range(1)), st.range(2) != 0};
   for (auto _ : st) {
-    const auto r = dynid::identify_stream(model, path, {}, o);
+    const auto r = dynid::identify_stream(model, path, {}, o, so);
     benchmark::DoNotOptimize(r.estimate.x.data());
   }
   st.counters["samples_per_s"] = benchmark::Counter(static_cast<double>(samples),
@@ -78,9 +79,15 @@ void BM_IdentifyStream(benchmark::State& st) {
 
 }  // namespace
 
+// Arguments: samples, worker threads, normal equations (1) or Householder (0) accumulation.
 BENCHMARK(BM_IdentifyStream)
-    ->Arg(100000)
-    ->Arg(1000000)
+    ->ArgNames({"samples", "threads", "normal_equations"})
+    ->Args({100000, 1, 0})
+    ->Args({100000, 1, 1})
+    ->Args({100000, 2, 1})
+    ->Args({1000000, 1, 1})
+    ->Args({1000000, 2, 1})
+    ->UseRealTime()
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1);
 

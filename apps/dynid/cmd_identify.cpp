@@ -27,6 +27,7 @@ struct IdentifyCliOptions {
   std::vector<double> zero_velocity;
   bool savgol = false;
   bool stream = false;
+  int threads = 0;
 };
 
 std::vector<std::string> split(const std::string& text, char sep) {
@@ -150,7 +151,7 @@ void run_identify(const IdentifyCliOptions& o) {
   file.columns = parse_column_mapping(o.columns);
   file.rate_hz = o.rate;
   const IdentificationResult result =
-      o.stream ? identify_stream(model, o.data, file, options)
+      o.stream ? identify_stream(model, o.data, file, options, {o.threads, true})
                : identify(model, read_joint_record(o.data, model, file), options);
   std::cout << identification_table(model, result);
   write_json(o.out, identification_to_json(model, result, echo(o)));
@@ -235,6 +236,10 @@ void add_identify_command(CLI::App& app) {
   cmd->add_flag("--stream", o->stream,
                 "Constant-memory mode for very long runs: reads the file in chunks; needs q, dq, "
                 "ddq, tau columns and --filter none");
+  cmd->add_option("--threads", o->threads,
+                  "With --stream: worker threads (0 = one per core); the result does not depend "
+                  "on it beyond round-off")
+      ->capture_default_str();
   add_signal_flags(cmd, *o);
   cmd->callback([o] { run_identify(*o); });
 }

@@ -2,8 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
+#include <sstream>
 #include <string>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 
 #include "dynid/common/error.hpp"
 #include "dynid/estimation/statistics.hpp"
@@ -17,14 +22,39 @@ using estimation_detail::solve_factor;
 using estimation_detail::triangular_append;
 
 namespace {
-// Rows gathered per group before a Householder update; bounds the scratch memory.
+// Rows gathered per group before they are folded in; bounds the scratch memory.
 constexpr Eigen::Index kChunk = 256;
 // Group variances below this fraction of the largest are floored (WLS weights stay finite).
 constexpr double kVarianceFloor = 1e-12;
+
+// Eigen-decomposition of a group's Gram matrix after column equilibration (D⁻¹GD⁻¹, unit
+// diagonal), shared by the accuracy test and the factor.
+struct ScaledGram {
+  Eigen::VectorXd d;  // column norms of [W_g y_g]
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig;
+  bool positive = false;  // every column non-zero
+};
+
+std::string short_number(double v) {
+  std::ostringstream out;
+  out << std::setprecision(3) << v;
+  return out.str();
+}
+
+ScaledGram scaled_gram(const Eigen::MatrixXd& upper) {
+  ScaledGram s;
+  const Eigen::MatrixXd G = upper.selfadjointView<Eigen::Upper>();
+  s.d = G.diagonal().cwiseMax(0.0).cwiseSqrt();
+  s.positive = (s.d.array() > 0.0).all();
+  const Eigen::VectorXd inv = s.d.unaryExpr([](double v) { return v > 0.0 ? 1.0 / v : 0.0; });
+  s.eig.compute(inv.asDiagonal() * G * inv.asDiagonal());
+  return s;
+}
 }  // namespace
 
-StreamingLeastSquares::StreamingLeastSquares(Eigen::Index parameters, int groups)
-    : parameters_(parameters) {
+StreamingLeastSquares::StreamingLeastSquares(Eigen::Index parameters, int groups,
+                                             const StreamingOptions& options)
+    : parameters_(parameters), options_(options) {
   if (parameters < 1) {
     throw Error("StreamingLeastSquares: parameters is " + std::to_string(parameters) +
                 "; W needs at least one column");
@@ -33,19 +63,50 @@ StreamingLeastSquares::StreamingLeastSquares(Eigen::Index parameters, int groups
     throw Error("StreamingLeastSquares: groups is " + std::to_string(groups) +
                 "; pass at least one row group (e.g. the joint count)");
   }
-  const Eigen::Index q = parameters + 1;
-  factors_.assign(groups, Eigen::MatrixXd::Zero(q, q));
-  group_rows_.assign(groups, 0);
-  scratch_.resize(kChunk, q);
-  work_.resize(q);
-  chunk_rows_.resize(groups);
-  for (auto& r : chunk_rows_) r.reserve(kChunk);
+  const auto& cols = options.group_columns;
+  if (!cols.empty() && static_cast<int>(cols.size()) != groups) {
+    throw Error("StreamingOptions::group_columns has " + std::to_string(cols.size()) +
+                " lists for " + std::to_string(groups) +
+                " groups; give one list per group or none");
+  }
+  groups_.resize(groups);
+  for (int g = 0; g < groups; ++g) {
+    Group& grp = groups_[g];
+    if (cols.empty()) {
+      grp.columns.resize(parameters);
+      for (Eigen::Index c = 0; c < parameters; ++c) grp.columns[c] = c;
+    } else {
+      grp.columns = cols[g];
+      for (std::size_t i = 0; i < grp.columns.size(); ++i) {
+        const Eigen::Index c = grp.columns[i];
+        if (c < 0 || c >= parameters || (i > 0 && c <= grp.columns[i - 1])) {
+          throw Error("StreamingOptions::group_columns[" + std::to_string(g) +
+                      "] is not a sorted list of distinct columns in [0, " +
+                      std::to_string(parameters) + "); fix entry " + std::to_string(i));
+        }
+      }
+    }
+    grp.columns.push_back(parameters);  // the y column
+    const auto q = static_cast<Eigen::Index>(grp.columns.size());
+    grp.summary = Eigen::MatrixXd::Zero(q, q);
+    grp.pending.resize(q, kChunk);
+  }
+  work_.resize(parameters + 1);
 }
 
 void StreamingLeastSquares::reset() {
-  for (auto& f : factors_) f.setZero();
-  std::fill(group_rows_.begin(), group_rows_.end(), 0);
+  for (auto& g : groups_) {
+    g.summary.setZero();
+    g.pending_rows = 0;
+    g.rows = 0;
+  }
   rows_ = 0;
+}
+
+std::vector<Eigen::Index> StreamingLeastSquares::group_rows() const {
+  std::vector<Eigen::Index> rows;
+  for (const auto& g : groups_) rows.push_back(g.rows);
+  return rows;
 }
 
 void StreamingLeastSquares::check_block(const Eigen::Ref<const Eigen::MatrixXd>& W,
@@ -76,30 +137,48 @@ void StreamingLeastSquares::check_block(const Eigen::Ref<const Eigen::MatrixXd>&
   }
 }
 
-void StreamingLeastSquares::append_group(int group, const Eigen::Ref<const Eigen::MatrixXd>& W,
-                                         const Eigen::Ref<const Eigen::VectorXd>& y,
-                                         const std::vector<Eigen::Index>& rows) {
-  const Eigen::Index b = static_cast<Eigen::Index>(rows.size());
-  auto B = scratch_.topRows(b);
-  for (Eigen::Index k = 0; k < b; ++k) {
-    B.row(k).head(parameters_) = W.row(rows[k]);
-    B(k, parameters_) = y(rows[k]);
+void StreamingLeastSquares::fold(Group& g) const {
+  if (g.pending_rows == 0) return;
+  const auto Bt = g.pending.leftCols(g.pending_rows);  // one row per column
+  if (options_.accumulation == Accumulation::kHouseholder) {
+    Eigen::MatrixXd B = Bt.transpose();
+    triangular_append(g.summary, B, work_);
+  } else {
+    g.summary.selfadjointView<Eigen::Upper>().rankUpdate(Bt);
   }
-  triangular_append(factors_[group], B, work_);
-  group_rows_[group] += b;
+  g.pending_rows = 0;
+}
+
+void StreamingLeastSquares::flush() const {
+  for (auto& g : groups_) fold(g);
+}
+
+void StreamingLeastSquares::add_full_row(int group, const Eigen::Ref<const Eigen::MatrixXd>& W,
+                                         const Eigen::Ref<const Eigen::VectorXd>& y,
+                                         Eigen::Index i) {
+  Group& g = groups_[group];
+  const auto pg = static_cast<Eigen::Index>(g.columns.size()) - 1;
+  std::size_t next = 0;
+  for (Eigen::Index c = 0; c < parameters_; ++c) {
+    if (next < static_cast<std::size_t>(pg) && g.columns[next] == c) {
+      g.pending(static_cast<Eigen::Index>(next++), g.pending_rows) = W(i, c);
+    } else if (W(i, c) != 0.0) {
+      throw Error("W row " + std::to_string(rows_ + i) + " (group " + std::to_string(group) +
+                  ") is non-zero in column " + std::to_string(c) +
+                  ", which StreamingOptions::group_columns excludes; add it to that list");
+    }
+  }
+  g.pending(pg, g.pending_rows) = y(i);
+  ++g.rows;
+  if (++g.pending_rows == kChunk) fold(g);
 }
 
 void StreamingLeastSquares::add(const Eigen::Ref<const Eigen::MatrixXd>& W,
                                 const Eigen::Ref<const Eigen::VectorXd>& y) {
   check_block(W, y);
   const Eigen::Index G = groups();
-  for (Eigen::Index start = 0; start < W.rows(); start += kChunk) {
-    const Eigen::Index end = std::min(W.rows(), start + kChunk);
-    for (auto& r : chunk_rows_) r.clear();
-    for (Eigen::Index i = start; i < end; ++i) chunk_rows_[(rows_ + i) % G].push_back(i);
-    for (int g = 0; g < G; ++g) {
-      if (!chunk_rows_[g].empty()) append_group(g, W, y, chunk_rows_[g]);
-    }
+  for (Eigen::Index i = 0; i < W.rows(); ++i) {
+    add_full_row(static_cast<int>((rows_ + i) % G), W, y, i);
   }
   rows_ += W.rows();
 }
@@ -119,33 +198,121 @@ void StreamingLeastSquares::add(const Eigen::Ref<const Eigen::MatrixXd>& W,
                   " but must be in [0, " + std::to_string(G) + "); use the joint index of the row");
     }
   }
-  for (Eigen::Index start = 0; start < W.rows(); start += kChunk) {
-    const Eigen::Index end = std::min(W.rows(), start + kChunk);
-    for (auto& r : chunk_rows_) r.clear();
-    for (Eigen::Index i = start; i < end; ++i) chunk_rows_[groups(i)].push_back(i);
-    for (int g = 0; g < G; ++g) {
-      if (!chunk_rows_[g].empty()) append_group(g, W, y, chunk_rows_[g]);
-    }
-  }
+  for (Eigen::Index i = 0; i < W.rows(); ++i) add_full_row(groups(i), W, y, i);
   rows_ += W.rows();
 }
 
-const Eigen::MatrixXd& StreamingLeastSquares::group_factor(int group) const {
+void StreamingLeastSquares::add_row(int group, const Eigen::Ref<const Eigen::VectorXd>& w,
+                                    double y) {
+  if (group < 0 || group >= groups()) {
+    throw Error("add_row: group " + std::to_string(group) + " is outside [0, " +
+                std::to_string(groups()) + "); pass the joint index of the row");
+  }
+  Group& g = groups_[group];
+  const auto pg = static_cast<Eigen::Index>(g.columns.size()) - 1;
+  if (w.size() != pg) {
+    throw Error("add_row: w has " + std::to_string(w.size()) + " entries but group " +
+                std::to_string(group) + " has " + std::to_string(pg) +
+                " columns; pass the row at StreamingOptions::group_columns only");
+  }
+  if (!w.allFinite() || !std::isfinite(y)) {
+    throw Error("row " + std::to_string(rows_) + " (group " + std::to_string(group) +
+                ") contains NaN or Inf; remove or repair that sample");
+  }
+  g.pending.col(g.pending_rows).head(pg) = w;
+  g.pending(pg, g.pending_rows) = y;
+  ++g.rows;
+  ++rows_;
+  if (++g.pending_rows == kChunk) fold(g);
+}
+
+void StreamingLeastSquares::merge(const StreamingLeastSquares& other) {
+  if (other.parameters_ != parameters_ || other.groups() != groups() ||
+      other.options_.accumulation != options_.accumulation) {
+    throw Error(
+        "merge: the accumulators differ in parameters, groups or accumulation; merge only "
+        "accumulators built with the same sizes and options");
+  }
+  for (int g = 0; g < groups(); ++g) {
+    if (other.groups_[g].columns != groups_[g].columns) {
+      throw Error("merge: group " + std::to_string(g) +
+                  " keeps different columns in the two accumulators; use the same group_columns");
+    }
+  }
+  other.flush();
+  flush();
+  for (int g = 0; g < groups(); ++g) {
+    Group& mine = groups_[g];
+    const Group& theirs = other.groups_[g];
+    if (theirs.rows == 0) continue;
+    if (options_.accumulation == Accumulation::kHouseholder) {
+      Eigen::MatrixXd B = theirs.summary;
+      triangular_append(mine.summary, B, work_);
+    } else {
+      mine.summary += theirs.summary;
+    }
+    mine.rows += theirs.rows;
+  }
+  rows_ += other.rows_;
+}
+
+double StreamingLeastSquares::normal_equations_condition(const Eigen::VectorXd& weights) const {
+  flush();
+  const Eigen::Index q = parameters_ + 1;
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(q, q);
+  for (int g = 0; g < groups(); ++g) {
+    const Group& grp = groups_[g];
+    if (grp.rows == 0) continue;
+    const Eigen::MatrixXd Gg = grp.summary.selfadjointView<Eigen::Upper>();
+    const double w2 = weights(g) * weights(g);
+    for (std::size_t r = 0; r < grp.columns.size(); ++r)
+      for (std::size_t c = 0; c < grp.columns.size(); ++c)
+        G(grp.columns[r], grp.columns[c]) += w2 * Gg(r, c);
+  }
+  const ScaledGram s = scaled_gram(G);
+  const double lmin = s.eig.eigenvalues()(0), lmax = s.eig.eigenvalues().maxCoeff();
+  if (!s.positive || !(lmin > 0.0)) return std::numeric_limits<double>::infinity();
+  return std::sqrt(lmax / lmin);  // κ of the equilibrated [W y] is √(λmax/λmin) of its Gram
+}
+
+Eigen::MatrixXd StreamingLeastSquares::compact_factor(const Group& g) const {
+  const Eigen::Index q = g.summary.rows();
+  if (g.rows == 0) return Eigen::MatrixXd::Zero(q, q);
+  if (options_.accumulation == Accumulation::kHouseholder) return g.summary;
+  // G = D V Λ Vᵀ D = SᵀS with S = Λ^½ Vᵀ D (negative round-off eigenvalues clamped); the R of
+  // S = QR is the upper-triangular factor with RᵀR = G. Eigenvalues below λmax/limit² are round-off
+  // of an exactly rank-deficient group (a joint that alone does not see every parameter) and are
+  // zeroed, so that the group's rank and residual come out right.
+  const ScaledGram s = scaled_gram(g.summary);
+  const double floor = s.eig.eigenvalues().maxCoeff() /
+                       (kNormalEquationsConditionLimit * kNormalEquationsConditionLimit);
+  const Eigen::VectorXd lambda =
+      s.eig.eigenvalues().unaryExpr([floor](double l) { return l > floor ? l : 0.0; });
+  const Eigen::MatrixXd S =
+      lambda.cwiseSqrt().asDiagonal() * s.eig.eigenvectors().transpose() * s.d.asDiagonal();
+  Eigen::HouseholderQR<Eigen::MatrixXd> qr(S);
+  return qr.matrixQR().triangularView<Eigen::Upper>();
+}
+
+Eigen::MatrixXd StreamingLeastSquares::group_factor(int group) const {
   if (group < 0 || group >= groups()) {
     throw Error("group " + std::to_string(group) + " is outside [0, " + std::to_string(groups()) +
                 "); pass a valid group index");
   }
-  return factors_[group];
+  flush();
+  const Group& g = groups_[group];
+  const Eigen::MatrixXd Rc = compact_factor(g);
+  Eigen::MatrixXd R = Eigen::MatrixXd::Zero(Rc.rows(), parameters_ + 1);
+  for (std::size_t c = 0; c < g.columns.size(); ++c) R.col(g.columns[c]) = Rc.col(c);
+  return R;
 }
 
 Eigen::MatrixXd StreamingLeastSquares::factor() const {
   const Eigen::Index q = parameters_ + 1;
   Eigen::MatrixXd R = Eigen::MatrixXd::Zero(q, q);
-  Eigen::MatrixXd B(q, q);
-  Eigen::RowVectorXd work(q);
-  for (const auto& f : factors_) {
-    B = f;
-    triangular_append(R, B, work);
+  for (int g = 0; g < groups(); ++g) {
+    Eigen::MatrixXd B = group_factor(g);
+    triangular_append(R, B, work_);
   }
   return R;
 }
@@ -159,17 +326,29 @@ Estimate StreamingLeastSquares::solve(const Eigen::VectorXd& weights, EstimatorK
                 " parameters; at least " + std::to_string(p) + " rows (" + std::to_string(p + 1) +
                 " for the statistics) are needed: add samples");
   }
+  flush();
+  if (options_.accumulation == Accumulation::kNormalEquations) {
+    const double kappa = normal_equations_condition(weights);
+    if (!(kappa <= kNormalEquationsConditionLimit)) {
+      throw NormalEquationsError(
+          "the normal equations of these rows are too ill-conditioned to be solved accurately "
+          "(column-equilibrated condition number of [W y] " +
+          short_number(kappa) + " > " + short_number(kNormalEquationsConditionLimit) +
+          ": poorly excited or noise-free data); accumulate the rows with "
+          "Accumulation::kHouseholder");
+    }
+  }
   const int G = groups();
+  std::vector<Eigen::MatrixXd> factors(G);
+  for (int g = 0; g < G; ++g) factors[g] = compact_factor(groups_[g]);
   // Combined factor of the weighted rows: rows of group g scaled by weights(g).
   Eigen::MatrixXd R = Eigen::MatrixXd::Zero(q, q);
-  {
-    Eigen::MatrixXd B(q, q);
-    Eigen::RowVectorXd work(q);
-    for (int g = 0; g < G; ++g) {
-      if (group_rows_[g] == 0) continue;
-      B = weights(g) * factors_[g];
-      triangular_append(R, B, work);
-    }
+  for (int g = 0; g < G; ++g) {
+    if (groups_[g].rows == 0) continue;
+    const auto& cols = groups_[g].columns;
+    Eigen::MatrixXd B = Eigen::MatrixXd::Zero(factors[g].rows(), q);
+    for (std::size_t c = 0; c < cols.size(); ++c) B.col(cols[c]) = weights(g) * factors[g].col(c);
+    triangular_append(R, B, work_);
   }
   const auto s = solve_factor(R, m, options);
 
@@ -186,39 +365,43 @@ Estimate StreamingLeastSquares::solve(const Eigen::VectorXd& weights, EstimatorK
   e.summary.condition_number = s.condition_number;
   e.summary.passes = 1;
 
-  // Residuals per group from the factors: ‖e_g‖ = ‖R_g·[x; −1]‖, ‖y_g‖ = ‖R_g(:, p)‖ (Q_g is
-  // orthogonal).
-  Eigen::VectorXd xa(q);
-  xa.head(p) = s.x;
-  xa(p) = -1.0;
+  // Residuals per group from the factors: ‖e_g‖ = ‖R_g·[x_g; −1]‖ (x at the group's columns),
+  // ‖y_g‖ = ‖R_g(:, y)‖ (Q_g is orthogonal).
   e.group_rows.resize(G);
   e.group_rms.resize(G);
   e.group_relative_error.resize(G);
   e.group_variance.resize(G);
   const double nan = std::numeric_limits<double>::quiet_NaN();
+  EstimationOptions group_options = options;  // names are those of all p columns
+  group_options.names.clear();
   double rss = 0.0, rss_weighted = 0.0, yy = 0.0;
   for (int g = 0; g < G; ++g) {
-    const auto& Rg = factors_[g];
-    const double mg = double(group_rows_[g]);
-    e.group_rows(g) = mg;
-    if (group_rows_[g] == 0) {
+    const Eigen::MatrixXd& Rg = factors[g];
+    const auto& cols = groups_[g].columns;
+    const auto pg = static_cast<Eigen::Index>(cols.size()) - 1;
+    const Eigen::Index mg = groups_[g].rows;
+    e.group_rows(g) = double(mg);
+    if (mg == 0) {
       e.group_rms(g) = e.group_relative_error(g) = e.group_variance(g) = nan;
       continue;
     }
+    Eigen::VectorXd xa(pg + 1);
+    for (Eigen::Index c = 0; c < pg; ++c) xa(c) = s.x(cols[c]);
+    xa(pg) = -1.0;
     const double eg2 = (Rg.triangularView<Eigen::Upper>() * xa).squaredNorm();
-    const double yg2 = Rg.col(p).squaredNorm();
+    const double yg2 = Rg.col(pg).squaredNorm();
     rss += eg2;
     rss_weighted += weights(g) * weights(g) * eg2;
     yy += yg2;
-    e.group_rms(g) = std::sqrt(eg2 / mg);
+    e.group_rms(g) = std::sqrt(eg2 / double(mg));
     e.group_relative_error(g) = yg2 > 0.0 ? std::sqrt(eg2 / yg2) : (eg2 > 0.0 ? nan : 0.0);
     // Gautier: σ_g² from the least-squares solution of the subsystem of group g alone,
     // ‖y_g − W_g x_g‖²/(m_g − rank W_g), unbiased whatever the noise of the other groups.
-    const auto sg = solve_factor(Rg, group_rows_[g], options);
-    Eigen::VectorXd xg(q);
-    xg.head(p) = sg.x;
-    xg(p) = -1.0;
-    const Eigen::Index dof_g = group_rows_[g] - sg.rank;
+    const auto sg = solve_factor(Rg, mg, group_options);
+    Eigen::VectorXd xg(pg + 1);
+    xg.head(pg) = sg.x;
+    xg(pg) = -1.0;
+    const Eigen::Index dof_g = mg - sg.rank;
     e.group_variance(g) =
         dof_g > 0 ? (Rg.triangularView<Eigen::Upper>() * xg).squaredNorm() / double(dof_g) : nan;
   }
@@ -294,7 +477,7 @@ Estimate StreamingLeastSquares::solve_weighted(const EstimationOptions& options)
   Eigen::VectorXd variance = ols.group_variance;
   double vmax = 0.0;
   for (int g = 0; g < G; ++g) {
-    if (group_rows_[g] == 0) continue;
+    if (groups_[g].rows == 0) continue;
     if (!std::isfinite(variance(g))) {
       variance(g) = ols.residual_variance;  // too few rows in the group: pooled variance
       warnings.push_back("group " + std::to_string(g) +
@@ -306,7 +489,7 @@ Estimate StreamingLeastSquares::solve_weighted(const EstimationOptions& options)
   Eigen::VectorXd weights = Eigen::VectorXd::Ones(G);
   if (vmax > 0.0 && std::isfinite(vmax)) {
     for (int g = 0; g < G; ++g) {
-      if (group_rows_[g] == 0) continue;
+      if (groups_[g].rows == 0) continue;
       if (!(variance(g) >= kVarianceFloor * vmax)) {
         variance(g) = kVarianceFloor * vmax;
         warnings.push_back("group " + std::to_string(g) +

@@ -1,5 +1,14 @@
 #include "dynid/io/streaming_identification.hpp"
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <condition_variable>
+#include <exception>
+#include <mutex>
+#include <random>
+#include <thread>
+
 #include "dynid/common/error.hpp"
 #include "dynid/estimation/streaming_least_squares.hpp"
 #include "dynid/io/csv_chunk_reader.hpp"
@@ -7,8 +16,211 @@
 
 namespace dynid {
 
+namespace {
+
+// Random states at which the sparsity of the base regressor is probed; velocities alternate in
+// sign so that one-sided (asymmetric Coulomb) columns are seen as well.
+constexpr int kSparsityProbes = 8;
+constexpr unsigned kSparsitySeed = 20261123;
+// Upper bound on worker threads (more do not help: the reader is serial).
+constexpr int kMaxThreads = 8;
+// Chunks queued per worker: enough to keep a worker busy while the reader serves the others.
+constexpr std::size_t kQueueDepth = 3;
+
+// Base columns (indices into base.base) that can be non-zero in each joint's torque row: the links
+// of the joint's subtree and the joint's own friction. Probed numerically at random states, since
+// an analytic function that vanishes at random points vanishes everywhere.
+std::vector<std::vector<Eigen::Index>> joint_base_columns(const Model& model,
+                                                          const ParameterLayout& layout,
+                                                          const BaseParameters& base) {
+  const int n = model.dof();
+  Workspace ws(model);
+  Eigen::MatrixXd Y(n, layout.columns(n));
+  Eigen::VectorXd q(n), dq(n), ddq(n);
+  std::mt19937 rng(kSparsitySeed);
+  std::uniform_real_distribution<double> angle(-3.0, 3.0), speed(0.2, 2.0);
+  std::vector<std::vector<char>> seen(n, std::vector<char>(base.rank, 0));
+  for (int probe = 0; probe < kSparsityProbes; ++probe) {
+    for (int j = 0; j < n; ++j) {
+      q[j] = angle(rng);
+      dq[j] = (probe % 2 == 0 ? 1.0 : -1.0) * speed(rng);
+      ddq[j] = angle(rng);
+    }
+    torque_regressor(model, ws, layout, q, dq, ddq, Y);
+    for (int j = 0; j < n; ++j)
+      for (int c = 0; c < base.rank; ++c) seen[j][c] |= Y(j, base.base[c]) != 0.0;
+  }
+  std::vector<std::vector<Eigen::Index>> columns(n);
+  for (int j = 0; j < n; ++j)
+    for (int c = 0; c < base.rank; ++c)
+      if (seen[j][c]) columns[j].push_back(c);
+  return columns;
+}
+
+// Everything one worker needs to turn a chunk of samples into accumulated rows.
+struct Worker {
+  Worker(const Model& model, int rank, const StreamingOptions& lsq_options)
+      : ws(model), lsq(rank, model.dof(), lsq_options) {}
+  Workspace ws;
+  StreamingLeastSquares lsq;
+  Eigen::MatrixXd Y;
+  Eigen::VectorXd q, dq, ddq, w;
+  // Ring of chunks handed over by the reader: [head, tail) are filled, in order.
+  std::mutex mutex;
+  std::condition_variable cv;
+  std::array<Eigen::MatrixXd, kQueueDepth> blocks;
+  std::array<Eigen::Index, kQueueDepth> first_rows{};
+  std::size_t head = 0, tail = 0;
+  bool done = false;
+  std::exception_ptr error;
+  Eigen::Index error_block = -1;
+};
+
+// The per-run constants shared read-only by the workers.
+struct StreamSetup {
+  const Model* model = nullptr;
+  const ParameterLayout* layout = nullptr;
+  const BaseParameters* base = nullptr;
+  std::string path;
+  std::vector<std::vector<Eigen::Index>> active;         // base columns per joint
+  std::vector<std::vector<Eigen::Index>> active_full;    // the same as regressor columns
+  std::vector<std::vector<Eigen::Index>> inactive_full;  // the others, checked to be zero
+  std::vector<Eigen::Index> cq, cdq, cddq, ctau;
+  Eigen::VectorXd threshold;
+};
+
+void process_block(const StreamSetup& s, Worker& w, const Eigen::MatrixXd& block,
+                   Eigen::Index first_row) {
+  const Model& model = *s.model;
+  const int n = model.dof();
+  for (Eigen::Index k = 0; k < block.rows(); ++k) {
+    // The CSV reader has already refused NaN and Inf fields, naming the line.
+    for (int j = 0; j < n; ++j) {
+      w.q[j] = block(k, s.cq[j]);
+      w.dq[j] = block(k, s.cdq[j]);
+      w.ddq[j] = block(k, s.cddq[j]);
+    }
+    torque_regressor(model, w.ws, *s.layout, w.q, w.dq, w.ddq, w.Y);
+    for (int j = 0; j < n; ++j) {
+      if (std::abs(w.dq[j]) < s.threshold[j]) continue;
+      const auto& act = s.active_full[j];
+      for (std::size_t c = 0; c < act.size(); ++c) w.w[c] = w.Y(j, act[c]);
+      for (Eigen::Index c : s.inactive_full[j]) {
+        if (w.Y(j, c) != 0.0) {
+          throw Error("internal: the regressor of joint " + model.joints[j].name +
+                      " is non-zero in a column probed as structurally zero (data row " +
+                      std::to_string(first_row + k + 1) + "); run without --stream and report it");
+        }
+      }
+      w.lsq.add_row(j, w.w.head(static_cast<Eigen::Index>(act.size())), block(k, s.ctau[j]));
+    }
+  }
+}
+
+// Reads the file once and accumulates every chunk; chunk k is processed by worker k mod W.
+// Returns the merged accumulator. The first error in file order is rethrown after all threads
+// have stopped, so no thread outlives the call.
+StreamingLeastSquares accumulate(const StreamSetup& s, const StreamingOptions& lsq_options,
+                                 int threads, Eigen::Index& samples) {
+  const int n = s.model->dof();
+  const int rank = s.base->rank;
+  std::vector<std::unique_ptr<Worker>> workers;
+  for (int t = 0; t < threads; ++t) {
+    workers.push_back(std::make_unique<Worker>(*s.model, rank, lsq_options));
+    Worker& w = *workers.back();
+    w.Y.resize(n, s.layout->columns(n));
+    w.q.resize(n);
+    w.dq.resize(n);
+    w.ddq.resize(n);
+    w.w.resize(rank);
+  }
+  CsvChunkReader reader(s.path);
+  samples = 0;
+  if (threads == 1) {
+    Eigen::MatrixXd block;
+    while (reader.next(block)) {
+      process_block(s, *workers[0], block, samples);
+      samples += block.rows();
+    }
+    return std::move(workers[0]->lsq);
+  }
+
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) {
+    pool.emplace_back([&s, &w = *workers[t], t, threads] {
+      for (Eigen::Index index = t;; index += threads) {
+        std::unique_lock<std::mutex> lock(w.mutex);
+        w.cv.wait(lock, [&w] { return w.head != w.tail || w.done; });
+        if (w.head == w.tail) return;
+        Eigen::MatrixXd& block = w.blocks[w.head % kQueueDepth];
+        const Eigen::Index first_row = w.first_rows[w.head % kQueueDepth];
+        const bool failed = static_cast<bool>(w.error);
+        lock.unlock();  // the reader only touches other slots while this one is in use
+        if (!failed) {
+          try {
+            process_block(s, w, block, first_row);
+          } catch (...) {
+            lock.lock();
+            w.error = std::current_exception();
+            w.error_block = index;
+            lock.unlock();
+          }
+        }
+        lock.lock();
+        ++w.head;
+        lock.unlock();
+        w.cv.notify_all();
+      }
+    });
+  }
+  std::exception_ptr reader_error;
+  Eigen::Index index = 0;
+  try {
+    Eigen::MatrixXd block;
+    while (reader.next(block)) {
+      Worker& w = *workers[index % threads];
+      std::unique_lock<std::mutex> lock(w.mutex);
+      w.cv.wait(lock, [&w] { return w.tail - w.head < kQueueDepth; });
+      if (w.error) break;
+      const Eigen::Index rows = block.rows();
+      w.blocks[w.tail % kQueueDepth].swap(block);
+      w.first_rows[w.tail % kQueueDepth] = samples;
+      ++w.tail;
+      lock.unlock();
+      w.cv.notify_all();
+      samples += rows;
+      ++index;
+    }
+  } catch (...) {
+    reader_error = std::current_exception();
+  }
+  for (auto& w : workers) {
+    {
+      std::lock_guard<std::mutex> lock(w->mutex);
+      w->done = true;
+    }
+    w->cv.notify_all();
+  }
+  for (auto& t : pool) t.join();
+  // The earliest failing chunk decides which error the user sees.
+  std::exception_ptr first = reader_error;
+  Eigen::Index first_block = reader_error ? index : -1;
+  for (auto& w : workers) {
+    if (w->error && (first_block < 0 || w->error_block < first_block)) {
+      first = w->error;
+      first_block = w->error_block;
+    }
+  }
+  if (first) std::rethrow_exception(first);
+  for (int t = 1; t < threads; ++t) workers[0]->lsq.merge(workers[t]->lsq);
+  return std::move(workers[0]->lsq);
+}
+
+}  // namespace
+
 IdentificationResult identify_stream(const Model& model, const std::string& path,
-                                     const RunFileOptions& file, const IdentifyOptions& options) {
+                                     const RunFileOptions& file, const IdentifyOptions& options,
+                                     const StreamingIdentificationOptions& stream) {
   if (options.signal.filter) {
     throw UsageError(
         "streaming identification reads the file once and cannot filter it; use "
@@ -16,6 +228,10 @@ IdentificationResult identify_stream(const Model& model, const std::string& path
   }
   if (options.estimator == IdentificationEstimator::kRls) {
     throw UsageError("streaming identification supports --estimator ols or wls");
+  }
+  if (stream.threads < 0) {
+    throw UsageError("--threads is " + std::to_string(stream.threads) +
+                     "; give 0 (one per core) or a positive count");
   }
   const int n = model.dof();
   IdentificationResult result;
@@ -28,80 +244,92 @@ IdentificationResult identify_stream(const Model& model, const std::string& path
   result.rank = result.base.rank;
   const int rank = result.rank;
 
-  CsvChunkReader reader(path);
-  std::vector<std::string> columns = reader.columns();
-  for (auto& name : columns) {
-    for (const auto& [from, to] : file.columns) {
-      if (name == from) name = to;
+  StreamSetup s;
+  s.model = &model;
+  s.layout = &options.layout;
+  s.base = &result.base;
+  s.path = path;
+  {
+    CsvChunkReader header(path);
+    std::vector<std::string> columns = header.columns();
+    for (auto& name : columns) {
+      for (const auto& [from, to] : file.columns) {
+        if (name == from) name = to;
+      }
     }
-  }
-  std::vector<std::string> joints;
-  for (const Joint& j : model.joints) joints.push_back(j.name);
-  for (const char* prefix : {"dq", "ddq"}) {
-    if (!has_joint_columns(columns, joints, prefix)) {
-      throw UsageError("'" + path + "' has no " + prefix +
-                       "* columns; streaming identification needs q, dq, ddq and tau on the joint "
-                       "side (drop --stream to derive them)");
+    std::vector<std::string> joints;
+    for (const Joint& j : model.joints) joints.push_back(j.name);
+    for (const char* prefix : {"dq", "ddq"}) {
+      if (!has_joint_columns(columns, joints, prefix)) {
+        throw UsageError("'" + path + "' has no " + prefix +
+                         "* columns; streaming identification needs q, dq, ddq and tau on the "
+                         "joint side (drop --stream to derive them)");
+      }
     }
+    s.cq = resolve_joint_columns(columns, joints, "q", path);
+    s.cdq = resolve_joint_columns(columns, joints, "dq", path);
+    s.cddq = resolve_joint_columns(columns, joints, "ddq", path);
+    s.ctau = resolve_joint_columns(columns, joints, "tau", path);
   }
-  const auto cq = resolve_joint_columns(columns, joints, "q", path);
-  const auto cdq = resolve_joint_columns(columns, joints, "dq", path);
-  const auto cddq = resolve_joint_columns(columns, joints, "ddq", path);
-  const auto ctau = resolve_joint_columns(columns, joints, "tau", path);
-  Eigen::VectorXd threshold = Eigen::VectorXd::Zero(n);
+  s.threshold = Eigen::VectorXd::Zero(n);
   const auto& zv = options.signal.zero_velocity;
-  if (zv.size() == 1) threshold.setConstant(zv[0]);
-  if (static_cast<int>(zv.size()) == n) threshold = Eigen::Map<const Eigen::VectorXd>(zv.data(), n);
+  if (zv.size() == 1) s.threshold.setConstant(zv[0]);
+  if (static_cast<int>(zv.size()) == n) {
+    s.threshold = Eigen::Map<const Eigen::VectorXd>(zv.data(), n);
+  }
   if (!zv.empty() && zv.size() != 1 && static_cast<int>(zv.size()) != n) {
     throw UsageError("--zero-velocity takes 1 or " + std::to_string(n) + " values");
   }
-  result.choices.emplace_back("mode",
-                              "streaming (constant memory), no filtering, dq and ddq as given");
-
-  StreamingLeastSquares lsq(rank, n);
-  Workspace ws(model);
-  const int p = options.layout.columns(n);
-  Eigen::MatrixXd Y(n, p), block;
-  Eigen::VectorXd q(n), dq(n), ddq(n);
-  Eigen::MatrixXd Wb;
-  Eigen::VectorXd yb;
-  Eigen::VectorXi gb;
-  Eigen::Index samples = 0, rows = 0;
-  while (reader.next(block)) {
-    Wb.resize(block.rows() * n, rank);
-    yb.resize(block.rows() * n);
-    gb.resize(block.rows() * n);
-    Eigen::Index r = 0;
-    for (Eigen::Index k = 0; k < block.rows(); ++k) {
-      for (int j = 0; j < n; ++j) {
-        q[j] = block(k, cq[j]);
-        dq[j] = block(k, cdq[j]);
-        ddq[j] = block(k, cddq[j]);
-      }
-      torque_regressor(model, ws, options.layout, q, dq, ddq, Y);
-      for (int j = 0; j < n; ++j) {
-        if (std::abs(dq[j]) < threshold[j]) continue;
-        for (int c = 0; c < rank; ++c) Wb(r, c) = Y(j, result.base.base[c]);
-        yb[r] = block(k, ctau[j]);
-        gb[r] = j;
-        ++r;
-      }
+  s.active = joint_base_columns(model, options.layout, result.base);
+  s.active_full.resize(n);
+  s.inactive_full.resize(n);
+  for (int j = 0; j < n; ++j) {
+    for (Eigen::Index c = 0, a = 0; c < rank; ++c) {
+      const bool active = a < static_cast<Eigen::Index>(s.active[j].size()) && s.active[j][a] == c;
+      (active ? s.active_full[j] : s.inactive_full[j]).push_back(result.base.base[c]);
+      a += active;
     }
-    lsq.add(Wb.topRows(r), yb.head(r), gb.head(r));
-    samples += block.rows();
-    rows += r;
   }
-  result.samples = samples;
-  result.rows = rows;
-  if (rows <= rank) {
-    throw Error("only " + std::to_string(rows) + " equations in '" + path + "' for " +
-                std::to_string(rank) + " base parameters; record a longer run");
-  }
+  const int threads =
+      stream.threads > 0
+          ? std::min(stream.threads, kMaxThreads)
+          : std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, kMaxThreads);
+  StreamingOptions lsq_options;
+  lsq_options.group_columns = s.active;
+  lsq_options.accumulation =
+      stream.normal_equations ? Accumulation::kNormalEquations : Accumulation::kHouseholder;
+
   EstimationOptions eo;
   eo.confidence_level = options.confidence_level;
   eo.names = result.names;
-  result.estimate = options.estimator == IdentificationEstimator::kWls ? lsq.solve_weighted(eo)
-                                                                       : lsq.solve_ordinary(eo);
+  const auto solve = [&](const StreamingLeastSquares& lsq) {
+    if (lsq.rows() <= rank) {
+      throw Error("only " + std::to_string(lsq.rows()) + " equations in '" + path + "' for " +
+                  std::to_string(rank) + " base parameters; record a longer run");
+    }
+    return options.estimator == IdentificationEstimator::kWls ? lsq.solve_weighted(eo)
+                                                              : lsq.solve_ordinary(eo);
+  };
+  Eigen::Index samples = 0;
+  StreamingLeastSquares lsq = accumulate(s, lsq_options, threads, samples);
+  std::string accumulation = stream.normal_equations
+                                 ? "normal equations (column-equilibrated condition of [W y] "
+                                   "within 1e5)"
+                                 : "Householder QR";
+  try {
+    result.estimate = solve(lsq);
+  } catch (const NormalEquationsError& e) {
+    lsq_options.accumulation = Accumulation::kHouseholder;
+    lsq = accumulate(s, lsq_options, threads, samples);
+    result.estimate = solve(lsq);
+    accumulation = std::string("Householder QR, second pass: ") + e.what();
+  }
+  result.choices.emplace_back("mode",
+                              "streaming (constant memory), no filtering, dq and ddq as given");
+  result.choices.emplace_back("accumulation", accumulation);
+  result.choices.emplace_back("threads", std::to_string(threads) + " workers + 1 reader");
+  result.samples = samples;
+  result.rows = lsq.rows();
   result.residual_rms = result.estimate.group_rms;
   result.joint_relative_error = result.estimate.group_relative_error;
   result.relative_error = result.estimate.relative_error;

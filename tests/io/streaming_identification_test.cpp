@@ -1,5 +1,6 @@
 #include <fstream>
 #include <random>
+#include <sstream>
 
 #include <gtest/gtest.h>
 
@@ -14,9 +15,10 @@ namespace {
 
 // A puma560 run with noisy torques written as CSV; streaming (chunked, constant memory) and
 // in-memory identification must give the same estimate and statistics.
-std::string write_run(const Model& model, int samples) {
+std::string write_run(const Model& model, int samples, double sigma = 0.3,
+                      const std::string& name = "stream_run.csv") {
   std::mt19937 rng(9);
-  std::normal_distribution<double> noise(0.0, 0.3);
+  std::normal_distribution<double> noise(0.0, sigma);
   const int n = model.dof();
   std::vector<std::string> cols = {"t"};
   for (const char* p : {"q", "dq", "ddq", "tau"})
@@ -36,7 +38,7 @@ std::string write_run(const Model& model, int samples) {
     for (int j = 0; j < n; ++j) tau[j] += noise(rng);
     data.row(k) << t, q.transpose(), dq.transpose(), ddq.transpose(), tau.transpose();
   }
-  const std::string path = ::testing::TempDir() + "/stream_run.csv";
+  const std::string path = ::testing::TempDir() + "/" + name;
   write_csv(path, cols, data);
   return path;
 }
@@ -57,6 +59,79 @@ TEST(StreamingIdentification, EqualsInMemoryIdentification) {
     EXPECT_LT((s.estimate.std_dev - m.estimate.std_dev).norm(), 1e-7 * m.estimate.std_dev.norm());
     EXPECT_NEAR(s.relative_error, m.relative_error, 1e-10);
   }
+}
+
+std::string choice(const IdentificationResult& r, const std::string& key) {
+  for (const auto& [k, v] : r.choices)
+    if (k == key) return v;
+  return "";
+}
+
+// Threads and normal equations change only the round-off: every combination equals the
+// single-threaded Householder pass, and a fixed thread count gives bit-identical results.
+TEST(StreamingIdentification, ThreadsAndNormalEquationsChangeOnlyRoundOff) {
+  const Model model = load_robot("puma560");
+  const std::string path = write_run(model, 20000, 0.3, "stream_threads.csv");  // 5 chunks
+  IdentifyOptions o;
+  o.signal.filter = false;
+  o.signal.zero_velocity = {0.05};
+  o.estimator = IdentificationEstimator::kWls;
+  const IdentificationResult ref = identify_stream(model, path, {}, o, {1, false});
+  EXPECT_EQ(choice(ref, "accumulation"), "Householder QR");
+  for (int threads : {1, 2, 3}) {
+    const IdentificationResult r = identify_stream(model, path, {}, o, {threads, true});
+    EXPECT_NE(choice(r, "accumulation").find("normal equations"), std::string::npos);
+    EXPECT_EQ(r.rows, ref.rows);
+    EXPECT_EQ(r.samples, 20000);
+    EXPECT_LT((r.estimate.x - ref.estimate.x).norm(), 1e-9 * ref.estimate.x.norm());
+    EXPECT_LT((r.estimate.std_dev - ref.estimate.std_dev).norm(),
+              1e-8 * ref.estimate.std_dev.norm());
+    EXPECT_NEAR(r.relative_error, ref.relative_error, 1e-10);
+    const IdentificationResult again = identify_stream(model, path, {}, o, {threads, true});
+    EXPECT_EQ(again.estimate.x, r.estimate.x);  // deterministic chunk-to-worker assignment
+  }
+}
+
+// Noise-free torques make [W y] singular: the normal equations are refused and a second,
+// Householder pass recovers the parameters exactly.
+TEST(StreamingIdentification, NoiseFreeRunFallsBackToHouseholderPass) {
+  const Model model = load_robot("puma560");
+  const std::string path = write_run(model, 3000, 0.0, "stream_exact.csv");
+  IdentifyOptions o;
+  o.signal.filter = false;
+  const IdentificationResult r = identify_stream(model, path, {}, o, {2, true});
+  EXPECT_NE(choice(r, "accumulation").find("Householder QR, second pass"), std::string::npos)
+      << choice(r, "accumulation");
+  EXPECT_LT(r.relative_error, 1e-10);
+  const IdentificationResult m = identify(model, read_joint_record(path, model), o);
+  EXPECT_LT((r.estimate.x - m.estimate.x).norm(), 1e-8 * m.estimate.x.norm());
+}
+
+TEST(StreamingIdentification, NanSampleNamesTheDataRowWithAnyThreadCount) {
+  const Model model = load_robot("puma560");
+  const std::string path = write_run(model, 9000, 0.3, "stream_nan.csv");
+  {
+    std::ifstream in(path);
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string s = text.str();
+    std::size_t pos = 0;
+    for (int line = 0; line < 6001; ++line) pos = s.find('\n', pos) + 1;  // data row 6001
+    const std::size_t q1 = s.find(',', pos) + 1;
+    s.replace(q1, s.find(',', q1) - q1, "nan");  // q1 of that sample
+    std::ofstream(path) << s;
+  }
+  IdentifyOptions o;
+  o.signal.filter = false;
+  for (int threads : {1, 2}) {
+    try {
+      identify_stream(model, path, {}, o, {threads, true});
+      ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("row 6001"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_THROW(identify_stream(model, path, {}, o, {-1, true}), UsageError);
 }
 
 TEST(StreamingIdentification, RefusesFilteringAndMissingDerivatives) {

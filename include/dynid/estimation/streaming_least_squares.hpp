@@ -4,32 +4,82 @@
 
 #include <Eigen/Core>
 
+#include "dynid/common/error.hpp"
 #include "dynid/estimation/estimate.hpp"
 
 namespace dynid {
 
+/// How StreamingLeastSquares folds rows into its per-group summaries.
+enum class Accumulation {
+  /// Triangular factor R_g of [W_g y_g] updated by Householder QR of [R_g; new rows]
+  /// (Golub–Van Loan §5.1, §6.5): backward stable whatever the conditioning, ≈ 2(p+1)² flops per
+  /// row in matrix–vector kernels.
+  kHouseholder,
+  /// Gram matrix [W_g y_g]ᵀ[W_g y_g] updated by a symmetric rank-k product: ≈ (p+1)² flops per row
+  /// in matrix–matrix kernels (about 3× faster), but round-off grows with κ², so solving throws
+  /// NormalEquationsError beyond kNormalEquationsConditionLimit (re-accumulate with kHouseholder).
+  kNormalEquations,
+};
+
+/// Options of StreamingLeastSquares.
+struct StreamingOptions {
+  Accumulation accumulation = Accumulation::kHouseholder;  ///< see Accumulation
+  /// Per group, the sorted distinct columns that can be non-zero in its rows; empty = all columns.
+  /// A joint's torque row has no entries for links outside its subtree or for other joints'
+  /// friction, so each per-joint summary shrinks from (p+1)² to (p_g+1)² numbers and flops.
+  std::vector<std::vector<Eigen::Index>> group_columns;
+};
+
+/// With Accumulation::kNormalEquations, the largest accepted condition number of the
+/// column-equilibrated, weighted [W y] of all groups: round-off in the Gram matrix then perturbs
+/// the solution and the residual by at most ≈ κ²·u ≈ 1e-6 relative (u = 1.1e-16), far below any
+/// noise-driven σ. A noise-free fit (y in the range of W) has an unbounded κ and is refused.
+inline constexpr double kNormalEquationsConditionLimit = 1e5;  // echoed as "1e5" by identify_stream
+
+/// Thrown by StreamingLeastSquares::solve_* with Accumulation::kNormalEquations when the
+/// accumulated normal equations exceed kNormalEquationsConditionLimit; re-accumulate the rows with
+/// Accumulation::kHouseholder (identify_stream does so with a second pass over the file).
+class NormalEquationsError : public Error {
+ public:
+  using Error::Error;
+};
+
 /// Least squares of y = W·x + e accumulated block by block in O(G·(p+1)²) memory, independent of
 /// the number of rows: for every row group g (joint) it keeps the upper-triangular factor R_g of
 /// [W_g y_g] (the "extra column" trick: R_g = [R_gp z_g; 0 ρ_g], R_gpᵀR_gp = W_gᵀW_g,
-/// R_gpᵀz_g = W_gᵀy_g), updated by Householder QR of [R_g; new rows] (Golub–Van Loan §6.5;
-/// seed 1 eq. 35 solved without forming WᵀW). The combined factor of all groups gives OLS; the
-/// per-group factors give exact per-group residuals, variances and WLS in the same single pass.
+/// R_gpᵀz_g = W_gᵀy_g), or its Gram matrix (StreamingOptions::accumulation), seed 1 eq. 35 solved
+/// through the factor. The combined factor of all groups gives OLS; the per-group factors give
+/// exact per-group residuals, variances and WLS in the same single pass. Accumulators fed with
+/// disjoint rows (e.g. by several threads) are combined with merge().
 class StreamingLeastSquares {
  public:
-  /// p = parameters (columns of W) ≥ 1, G = groups ≥ 1. Throws dynid::Error otherwise.
-  explicit StreamingLeastSquares(Eigen::Index parameters, int groups = 1);
+  /// p = parameters (columns of W) ≥ 1, G = groups ≥ 1. Throws dynid::Error otherwise, or when
+  /// options.group_columns is neither empty nor G lists of sorted distinct columns in [0, p).
+  explicit StreamingLeastSquares(Eigen::Index parameters, int groups = 1,
+                                 const StreamingOptions& options = {});
 
   /// Adds rows; row r of the whole stream (counted from the first row ever added) belongs to
   /// group r mod G (sample-major torque regressor: group = joint). W is b×p, y has b entries.
-  /// Throws dynid::Error on wrong sizes or NaN/Inf (naming the stream row).
+  /// Throws dynid::Error on wrong sizes, NaN/Inf (naming the stream row), or a non-zero entry in a
+  /// column outside the row's group_columns.
   void add(const Eigen::Ref<const Eigen::MatrixXd>& W, const Eigen::Ref<const Eigen::VectorXd>& y);
 
   /// Adds rows with explicit group indices in [0, G). Same errors, plus out-of-range groups.
   void add(const Eigen::Ref<const Eigen::MatrixXd>& W, const Eigen::Ref<const Eigen::VectorXd>& y,
            const Eigen::Ref<const Eigen::VectorXi>& groups);
 
+  /// Adds one row of `group` given only at its group_columns (w has p_g entries, in that order):
+  /// the allocation-free path for streams built row by row. Throws dynid::Error on a bad group or
+  /// size, or NaN/Inf (naming the stream row).
+  void add_row(int group, const Eigen::Ref<const Eigen::VectorXd>& w, double y);
+
+  /// Adds the rows accumulated by `other` (same parameters, groups and options), as if they had
+  /// been added here. Throws dynid::Error on a mismatch.
+  void merge(const StreamingLeastSquares& other);
+
   /// Ordinary least squares from the accumulated factor (rank, condition number, statistics).
-  /// Throws dynid::Error if fewer rows than parameters were added.
+  /// Throws dynid::Error if fewer rows than parameters were added, and NormalEquationsError with
+  /// Accumulation::kNormalEquations when the normal equations are too ill-conditioned.
   Estimate solve_ordinary(const EstimationOptions& options = {}) const;
 
   /// Gautier's two-step weighted least squares: σ_g² from the OLS of each group's rows alone, then
@@ -43,33 +93,44 @@ class StreamingLeastSquares {
 
   /// Upper-triangular (p+1)×(p+1) factor of [W y] over all groups, with unit group weights.
   Eigen::MatrixXd factor() const;
-  /// Upper-triangular (p+1)×(p+1) factor of [W_g y_g] of group g.
-  const Eigen::MatrixXd& group_factor(int group) const;
+  /// (p+1)×(p+1) factor of [W_g y_g] of group g (upper triangular in group g's columns).
+  Eigen::MatrixXd group_factor(int group) const;
 
-  Eigen::Index rows() const { return rows_; }                       ///< rows added so far
-  Eigen::Index parameters() const { return parameters_; }           ///< p
-  int groups() const { return static_cast<int>(factors_.size()); }  ///< G
+  Eigen::Index rows() const { return rows_; }                      ///< rows added so far
+  Eigen::Index parameters() const { return parameters_; }          ///< p
+  int groups() const { return static_cast<int>(groups_.size()); }  ///< G
   /// Rows added per group.
-  const std::vector<Eigen::Index>& group_rows() const { return group_rows_; }
+  std::vector<Eigen::Index> group_rows() const;
+  const StreamingOptions& options() const { return options_; }  ///< as constructed
   /// Forgets all rows (keeps sizes).
   void reset();
 
  private:
+  struct Group {
+    std::vector<Eigen::Index> columns;  // the p_g columns kept, then p (the y column)
+    Eigen::MatrixXd summary;  // (p_g+1)²: factor R_g or upper triangle of the Gram matrix
+    Eigen::MatrixXd pending;  // rows not yet folded in, one per column: (p_g+1) × kChunk
+    Eigen::Index pending_rows = 0;
+    Eigen::Index rows = 0;
+  };
   void check_block(const Eigen::Ref<const Eigen::MatrixXd>& W,
                    const Eigen::Ref<const Eigen::VectorXd>& y) const;
-  void append_group(int group, const Eigen::Ref<const Eigen::MatrixXd>& W,
-                    const Eigen::Ref<const Eigen::VectorXd>& y,
-                    const std::vector<Eigen::Index>& rows);
+  void add_full_row(int group, const Eigen::Ref<const Eigen::MatrixXd>& W,
+                    const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Index i);
+  void fold(Group& g) const;
+  // κ of the column-equilibrated [W y] with rows of group g scaled by weights(g) (NE mode).
+  double normal_equations_condition(const Eigen::VectorXd& weights) const;
+  void flush() const;
+  // Compact (p_g+1)² upper-triangular factor of group g; empty when it has no rows.
+  Eigen::MatrixXd compact_factor(const Group& g) const;
   Estimate solve(const Eigen::VectorXd& weights, EstimatorKind kind,
                  const EstimationOptions& options) const;
 
   Eigen::Index parameters_;
+  StreamingOptions options_;
   Eigen::Index rows_ = 0;
-  std::vector<Eigen::MatrixXd> factors_;  // R_g, (p+1)×(p+1) upper triangular
-  std::vector<Eigen::Index> group_rows_;
-  Eigen::MatrixXd scratch_;  // gathered rows of one group, ≤ kChunk × (p+1)
-  Eigen::RowVectorXd work_;  // Householder workspace
-  std::vector<std::vector<Eigen::Index>> chunk_rows_;  // row indices per group in a chunk
+  mutable std::vector<Group> groups_;  // mutable: solving folds pending rows in first
+  mutable Eigen::RowVectorXd work_;    // Householder workspace
 };
 
 }  // namespace dynid
