@@ -161,6 +161,7 @@ void run_identify(const IdentifyCliOptions& o) {
 struct ValidateCliOptions {
   std::string robot, params, data, json, columns, mode = "torque", trajectory, engine = "mujoco";
   double rate = 0.0;
+  std::vector<double> zero_velocity;
 };
 
 void run_validate(const ValidateCliOptions& v) {
@@ -186,6 +187,8 @@ void run_validate(const ValidateCliOptions& v) {
   o.filter = used.value("filter", o.filter);
   o.cutoff = used.value("cutoff_hz", 0.0);
   o.savgol = used.value("savitzky_golay", false);
+  o.zero_velocity = v.zero_velocity.empty() ? used.value("zero_velocity", std::vector<double>{})
+                                            : v.zero_velocity;
   const IdentifyOptions options = library_options(o);
   RunFileOptions file;
   file.columns = parse_column_mapping(v.columns);
@@ -263,6 +266,10 @@ void add_validate_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--rate", v->rate, "Sample rate [Hz] when the file has no t column");
   cmd->add_option("--columns", v->columns, "Rename columns before lookup: from=to,from2=to2");
+  cmd->add_option("--zero-velocity", v->zero_velocity,
+                  "Leave rows of joint j with |dq_j| below this [rad/s] out of the torque "
+                  "statistics (1 or n values); default: as the identification did; 0 keeps all")
+      ->delimiter(',');
   cmd->callback([v] { run_validate(*v); });
 }
 

@@ -189,6 +189,37 @@ ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& option
   return out;
 }
 
+namespace {
+
+// Rows of joint j where |dq_j| is below threshold_j, too small for sign(dq_j) to be meaningful, are
+// left out when the layout has Coulomb friction: given values (1 or n), or by default 1 % of
+// max|dq_j| of the processed record (on the TX40 this reproduces FIGAROH's thresholds). Zero
+// without Coulomb friction. The choice is appended to `choices`.
+Eigen::VectorXd zero_velocity_threshold(const IdentifyOptions& options, const Eigen::MatrixXd& dq,
+                                        const char* verb,
+                                        std::vector<std::pair<std::string, std::string>>& choices) {
+  const auto n = dq.cols();
+  Eigen::VectorXd threshold = Eigen::VectorXd::Zero(n);
+  if (!options.layout.coulomb) return threshold;
+  const auto& zv = options.signal.zero_velocity;
+  if (zv.empty()) {
+    threshold = 0.01 * dq.cwiseAbs().colwise().maxCoeff().transpose();
+  } else if (zv.size() == 1) {
+    threshold.setConstant(zv[0]);
+  } else if (static_cast<Eigen::Index>(zv.size()) == n) {
+    threshold = Eigen::Map<const Eigen::VectorXd>(zv.data(), n);
+  } else {
+    throw UsageError("--zero-velocity takes 1 or " + std::to_string(n) + " values, got " +
+                     std::to_string(zv.size()));
+  }
+  std::ostringstream s;
+  s << "rows with |dq_j| < [" << threshold.transpose() << "] " << verb << " (Coulomb friction)";
+  choices.emplace_back("zero_velocity", s.str());
+  return threshold;
+}
+
+}  // namespace
+
 IdentificationResult identify(const Model& model, const JointRecord& record,
                               const IdentifyOptions& options) {
   const int n = model.dof();
@@ -212,25 +243,9 @@ IdentificationResult identify(const Model& model, const JointRecord& record,
   result.unidentifiable = result.base.unidentifiable_names();
   result.rank = result.base.rank;
 
-  // Rows of joint j where |dq_j| is too small for sign(dq_j) to be meaningful are dropped.
-  Eigen::VectorXd threshold = Eigen::VectorXd::Zero(n);
+  const Eigen::VectorXd threshold =
+      zero_velocity_threshold(options, r.dq, "removed", result.choices);
   const bool coulomb = options.layout.coulomb;
-  if (coulomb) {
-    const auto& zv = options.signal.zero_velocity;
-    if (zv.empty()) {
-      threshold = 0.01 * r.dq.cwiseAbs().colwise().maxCoeff().transpose();
-    } else if (zv.size() == 1) {
-      threshold.setConstant(zv[0]);
-    } else if (static_cast<int>(zv.size()) == n) {
-      threshold = Eigen::Map<const Eigen::VectorXd>(zv.data(), n);
-    } else {
-      throw UsageError("--zero-velocity takes 1 or " + std::to_string(n) + " values, got " +
-                       std::to_string(zv.size()));
-    }
-    std::ostringstream s;
-    s << "rows with |dq_j| < [" << threshold.transpose() << "] removed (Coulomb friction)";
-    result.choices.emplace_back("zero_velocity", s.str());
-  }
   const Eigen::MatrixXd W_full = stacked_regressor(model, options.layout, coupling, r);
   std::vector<Eigen::Index> keep;
   keep.reserve(m * n);
@@ -297,9 +312,8 @@ ValidationResult validate_torques(const Model& model, const JointRecord& record,
     throw Error("the run has " + std::to_string(record.q.cols()) + " joints but model '" +
                 model.name + "' has " + std::to_string(n));
   }
-  std::vector<std::pair<std::string, std::string>> choices;
   ValidationResult out;
-  out.processed = preprocess(record, options.signal, choices);
+  out.processed = preprocess(record, options.signal, out.choices);
   const JointRecord& r = out.processed.record;
   const std::vector<std::string> columns = stacked_regressor_names(
       model, options.layout, options.coupling && !coupled_motors(model).empty());
@@ -328,11 +342,32 @@ ValidationResult validate_torques(const Model& model, const JointRecord& record,
   out.predicted =
       Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
           pred.data(), m, n);
+  // Errors on the joint equations identify() would use: near-zero-velocity rows of a Coulomb
+  // model are left out the same way (their sign(dq) is noise), and reported apart.
+  const Eigen::VectorXd threshold =
+      zero_velocity_threshold(options, r.dq, "left out of the error statistics", out.choices);
   const Eigen::MatrixXd e = r.tau - out.predicted;
-  out.rms = (e.colwise().squaredNorm() / static_cast<double>(m)).cwiseSqrt().transpose();
-  out.relative_error =
-      (e.colwise().norm().array() / r.tau.colwise().norm().array().max(1e-300)).transpose();
-  out.relative_error_all = e.norm() / r.tau.norm();
+  Eigen::VectorXd e2 = Eigen::VectorXd::Zero(n), y2 = Eigen::VectorXd::Zero(n),
+                  cnt = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    for (int j = 0; j < n; ++j) {
+      if (std::abs(r.dq(k, j)) < threshold[j]) continue;
+      e2[j] += e(k, j) * e(k, j);
+      y2[j] += r.tau(k, j) * r.tau(k, j);
+      cnt[j] += 1.0;
+    }
+  }
+  out.rows = static_cast<Eigen::Index>(cnt.sum());
+  out.rows_excluded = m * n - out.rows;
+  if (out.rows == 0) {
+    throw Error(
+        "every sample is below the zero-velocity threshold; the run does not move, or "
+        "lower --zero-velocity");
+  }
+  out.rms = (e2.array() / cnt.array().max(1.0)).sqrt();
+  out.relative_error = (e2.array() / y2.array().max(1e-300)).sqrt();
+  out.relative_error_all = std::sqrt(e2.sum() / std::max(y2.sum(), 1e-300));
+  out.relative_error_all_rows = e.norm() / std::max(r.tau.norm(), 1e-300);
   return out;
 }
 

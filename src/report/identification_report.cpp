@@ -156,9 +156,15 @@ nlohmann::json validation_to_json(const Model& model, const ValidationResult& v)
                       {"rms", json_number(v.rms[j])},
                       {"relative_error", json_number(v.relative_error[j])}});
   }
+  nlohmann::json choices = nlohmann::json::object();
+  for (const auto& [key, value] : v.choices) choices[key] = value;
   return {{"joints", joints},
           {"relative_error", json_number(v.relative_error_all)},
+          {"relative_error_all_rows", json_number(v.relative_error_all_rows)},
           {"samples", v.samples},
+          {"rows", v.rows},
+          {"rows_excluded_zero_velocity", v.rows_excluded},
+          {"choices", choices},
           {"version", kVersion}};
 }
 
@@ -170,6 +176,13 @@ std::string validation_table(const Model& model, const ValidationResult& v) {
   }
   s << line("all joints: relative error %.2f %% over %ld samples\n", 100 * v.relative_error_all,
             static_cast<long>(v.samples));
+  if (v.rows_excluded > 0) {
+    s << line(
+        "  (%ld of %ld joint rows with |dq| below the zero-velocity threshold left out, as in "
+        "identify; with them: %.2f %%; --zero-velocity 0 compares every row)\n",
+        static_cast<long>(v.rows_excluded), static_cast<long>(v.rows + v.rows_excluded),
+        100 * v.relative_error_all_rows);
+  }
   return s.str();
 }
 

@@ -14,15 +14,19 @@ namespace {
 struct CliRun {
   int code;
   std::string err;
+  std::string out;
 };
 
 CliRun run(const std::string& args) {
   const std::string err_path = ::testing::TempDir() + "/identify_cli_err.txt";
-  const std::string cmd = std::string(DYNID_BINARY) + " " + args + " > /dev/null 2> " + err_path;
+  const std::string out_path = ::testing::TempDir() + "/identify_cli_out.txt";
+  const std::string cmd =
+      std::string(DYNID_BINARY) + " " + args + " > " + out_path + " 2> " + err_path;
   const int status = std::system(cmd.c_str());
-  std::ifstream f(err_path);
+  std::ifstream f(err_path), o(out_path);
   std::string err((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-  return {WEXITSTATUS(status), err};
+  std::string out((std::istreambuf_iterator<char>(o)), std::istreambuf_iterator<char>());
+  return {WEXITSTATUS(status), err, out};
 }
 
 nlohmann::json load(const std::string& path) {
@@ -96,6 +100,35 @@ TEST(IdentifyCli, IdentifyAndValidateWriteTheirInterfaces) {
   EXPECT_EQ(v["joints"].size(), 2u);
   EXPECT_TRUE(v["joints"][0].contains("rms"));
   EXPECT_LT(v["relative_error"].get<double>(), 1e-4);
+}
+
+// validate leaves out the rows identify left out (|dq_j| below the zero-velocity threshold stored
+// in the result) and says how many; --zero-velocity 0 compares every row.
+TEST(IdentifyCli, ValidateUsesTheIdentificationZeroVelocityThreshold) {
+  const std::string data = planar2_run();
+  const std::string out = ::testing::TempDir() + "/planar2_coulomb.json";
+  ASSERT_EQ(run("identify --robot planar2 --data " + data +
+                " --filter none --friction viscous,coulomb --zero-velocity 0.3 --out " + out)
+                .code,
+            0);
+  const auto id = load(out);
+  const std::string val = ::testing::TempDir() + "/planar2_coulomb_val.json";
+  CliRun r = run("validate --robot planar2 --params " + out + " --data " + data + " --json " + val);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("left out, as in identify"), std::string::npos) << r.out;
+  auto v = load(val);
+  const long samples = v["samples"].get<long>();
+  EXPECT_GT(v["rows_excluded_zero_velocity"].get<long>(), 0);
+  EXPECT_EQ(v["rows"].get<long>(), id["rows"].get<long>());
+  EXPECT_EQ(v["rows"].get<long>() + v["rows_excluded_zero_velocity"].get<long>(), 2 * samples);
+  EXPECT_NEAR(v["relative_error"].get<double>(), id["relative_error"].get<double>(), 1e-9);
+  ASSERT_EQ(run("validate --robot planar2 --params " + out + " --data " + data +
+                " --zero-velocity 0 --json " + val)
+                .code,
+            0);
+  v = load(val);
+  EXPECT_EQ(v["rows_excluded_zero_velocity"].get<long>(), 0);
+  EXPECT_EQ(v["rows"].get<long>(), 2 * samples);
 }
 
 TEST(IdentifyCli, BadInputsGiveOneErrorLineAndNoOutput) {

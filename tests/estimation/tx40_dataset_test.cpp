@@ -52,8 +52,13 @@ class Tx40Dataset : public ::testing::Test {
     r.q = joint_positions_from_motor(model, pos.data);
     r.tau = joint_torques_from_motor(model, cur.data);
     result_ = new IdentificationResult(identify(model, r));
+    validation_ = new ValidationResult(
+        validate_torques(model, r, result_->names, result_->estimate.x, IdentifyOptions{}));
   }
-  static void TearDownTestSuite() { delete result_; }
+  static void TearDownTestSuite() {
+    delete result_;
+    delete validation_;
+  }
   void SetUp() override {
     if (result_ == nullptr) GTEST_SKIP() << "data set not found at " << kData;
   }
@@ -64,13 +69,28 @@ class Tx40Dataset : public ::testing::Test {
     return it == names.end() ? NAN : result_->estimate.x[it - names.begin()];
   }
   static IdentificationResult* result_;
+  static ValidationResult* validation_;
 };
 IdentificationResult* Tx40Dataset::result_ = nullptr;
+ValidationResult* Tx40Dataset::validation_ = nullptr;
 
 TEST_F(Tx40Dataset, RankAndRelativeTorqueError) {
   EXPECT_EQ(result_->rank, 61);  // 60 inertial + 27 extra columns, rank 61 (SOURCE.md)
   EXPECT_GT(result_->relative_error, 0.04);
   EXPECT_LT(result_->relative_error, 0.055);
+}
+
+// Validating on the identification run itself compares the same joint rows (near-zero-velocity
+// rows left out alike), so the OLS prediction error equals the identification residual; with every
+// row kept it is much larger (sign(dq) of a derived velocity is noise near zero).
+TEST_F(Tx40Dataset, ValidationOnTheSameRunReproducesTheIdentificationError) {
+  EXPECT_EQ(validation_->rows, result_->rows);
+  EXPECT_EQ(validation_->rows + validation_->rows_excluded, 6 * result_->samples);
+  EXPECT_NEAR(validation_->relative_error_all, result_->relative_error, 1e-9);
+  for (int j = 0; j < 6; ++j) {
+    EXPECT_NEAR(validation_->rms[j], result_->residual_rms[j], 1e-9 * result_->residual_rms[j]);
+  }
+  EXPECT_GT(validation_->relative_error_all_rows, 2.0 * validation_->relative_error_all);
 }
 
 TEST_F(Tx40Dataset, FrictionMatchesPublishedValues) {

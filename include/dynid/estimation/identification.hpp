@@ -100,17 +100,25 @@ IdentificationResult identify(const Model& model, const JointRecord& record,
 
 /// Per-joint prediction error of identified base parameters on another record (dynid validate).
 struct ValidationResult {
-  Eigen::VectorXd rms;              ///< per joint [N·m]
-  Eigen::VectorXd relative_error;   ///< per joint ‖e_j‖/‖tau_j‖
-  double relative_error_all = 0.0;  ///< ‖e‖/‖tau‖ over all joints
-  Eigen::Index samples = 0;
+  Eigen::VectorXd rms;              ///< per joint [N·m], on the rows compared
+  Eigen::VectorXd relative_error;   ///< per joint ‖e_j‖/‖tau_j‖, on the rows compared
+  double relative_error_all = 0.0;  ///< ‖e‖/‖tau‖ over all joints, on the rows compared
+  /// ‖e‖/‖tau‖ over every sample, near-zero-velocity rows included.
+  double relative_error_all_rows = 0.0;
+  Eigen::Index samples = 0;        ///< samples after preprocessing
+  Eigen::Index rows = 0;           ///< joint equations compared (samples × joints − excluded)
+  Eigen::Index rows_excluded = 0;  ///< near-zero-velocity rows left out, as identify() does
+  std::vector<std::pair<std::string, std::string>> choices;  ///< processing choices made
   ProcessedRecord processed;
   Eigen::MatrixXd predicted;  ///< samples × n predicted torques
 };
 
 /// Predicts the torques of `record` with base parameters `values` named `names` (as identify()
-/// wrote them) and compares. The base set is recomputed from the model with the same layout; a
-/// name that is not in it is an Error naming the parameter.
+/// wrote them) and compares. The record is preprocessed and, with Coulomb friction in the layout,
+/// rows with |dq_j| below the zero-velocity threshold are left out of the statistics exactly as
+/// identify() leaves them out of the fit (so validating on the identification run reproduces its
+/// relative error); relative_error_all_rows keeps them. A name that is not a column of the model
+/// and layout is an Error naming the parameter.
 ValidationResult validate_torques(const Model& model, const JointRecord& record,
                                   const std::vector<std::string>& names,
                                   const Eigen::VectorXd& values, const IdentifyOptions& options);
