@@ -224,6 +224,25 @@ TEST(MujocoPlant, CoulombStopsTheJointInBothEngines) {
   }
 }
 
+// A light joint (J = 1.2e-3 kg·m², like a wrist) is where MuJoCo's default soft frictionloss acts
+// like viscous damping; with the plant's stiff friction constraint it decelerates at the Coulomb
+// rate Fc/J and stops after J·v/Fc = 24 ms, as the closed form says.
+TEST(MujocoPlant, CoulombOnALightJointDeceleratesAtFcOverJ) {
+  Model model = testing::pendulum(0.1, 0.1, 1e-4, 1e-4, 0.0);
+  model.gravity = Eigen::Vector3d(0, 0, -9.81);  // along the axis: no gravity torque
+  model.joints[0].friction.Fc = 0.05;
+  const double J = 0.1 * 0.01 + 1e-4 + 1e-4, t_stop = J * 1.0 / 0.05;
+  PlantOptions o;
+  o.engine = PlantEngine::kMujoco;
+  auto plant = make_plant(model, o);
+  plant->reset(Eigen::VectorXd::Zero(1), Eigen::VectorXd::Constant(1, 1.0));
+  for (int k = 0; k < 12; ++k) plant->step(Eigen::VectorXd::Zero(1));  // half of t_stop
+  EXPECT_NEAR(plant->dq()[0], 1.0 - 0.012 / t_stop, 0.05);
+  for (int k = 0; k < 48; ++k) plant->step(Eigen::VectorXd::Zero(1));
+  EXPECT_LT(std::abs(plant->dq()[0]), 0.02);
+  EXPECT_NEAR(plant->q()[0], 0.5 * J / 0.05, 0.1 * 0.5 * J / 0.05);  // stopping distance J v²/(2Fc)
+}
+
 TEST(Plant, RejectsBadInput) {
   const Model model = testing::pendulum();
   PlantOptions o;
