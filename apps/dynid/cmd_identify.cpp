@@ -28,6 +28,8 @@ struct IdentifyCliOptions {
   bool savgol = false;
   bool stream = false;
   int threads = 0;
+  double torque_offset = 0.0;
+  bool filter_coulomb = false;
 };
 
 std::vector<std::string> split(const std::string& text, char sep) {
@@ -103,6 +105,8 @@ IdentifyOptions library_options(const IdentifyCliOptions& o) {
   out.signal.trim = o.trim;
   out.signal.zero_velocity = o.zero_velocity;
   out.signal.savitzky_golay = o.savgol;
+  out.signal.torque_time_offset = o.torque_offset;
+  out.signal.filter_coulomb_columns = o.filter_coulomb;
   return out;
 }
 
@@ -120,6 +124,8 @@ nlohmann::json echo(const IdentifyCliOptions& o) {
           {"confidence_level", o.confidence},
           {"zero_velocity", o.zero_velocity},
           {"savitzky_golay", o.savgol},
+          {"torque_offset_s", o.torque_offset},
+          {"filter_coulomb_columns", o.filter_coulomb},
           {"columns", o.columns}};
 }
 
@@ -142,6 +148,12 @@ void add_signal_flags(CLI::App* cmd, IdentifyCliOptions& o) {
                   "Friction terms: comma list of viscous, coulomb, offset; or asymmetric; or none")
       ->capture_default_str();
   cmd->add_flag("--no-armature", o.no_armature, "Do not identify the actuator inertias Ia");
+  cmd->add_option("--torque-offset", o.torque_offset,
+                  "The torque logged at t acts at t + S [s]: half the sample period for a "
+                  "command held over the next step (dynid simulate), -d for a sensor lagging d");
+  cmd->add_flag("--filter-coulomb", o.filter_coulomb,
+                "Filter the sign(dq) columns like tau (parallel filtering): unbiased Fv and Fc "
+                "when the filter smears the Coulomb step at reversals");
 }
 
 void run_identify(const IdentifyCliOptions& o) {
@@ -187,6 +199,8 @@ void run_validate(const ValidateCliOptions& v) {
   o.filter = used.value("filter", o.filter);
   o.cutoff = used.value("cutoff_hz", 0.0);
   o.savgol = used.value("savitzky_golay", false);
+  o.torque_offset = used.value("torque_offset_s", 0.0);
+  o.filter_coulomb = used.value("filter_coulomb_columns", false);
   o.zero_velocity = v.zero_velocity.empty() ? used.value("zero_velocity", std::vector<double>{})
                                             : v.zero_velocity;
   const IdentifyOptions options = library_options(o);

@@ -114,9 +114,26 @@ ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& option
   }
   const double rate = info.rate_hz();
   choices.emplace_back("sample_rate_hz", fmt(rate));
+  if (options.torque_time_offset != 0.0) {
+    if (!std::isfinite(options.torque_time_offset) ||
+        std::abs(options.torque_time_offset) * rate > 100.0) {
+      throw UsageError("--torque-offset " + fmt(options.torque_time_offset) +
+                       " s is not a small finite time (at most 100 samples); give e.g. " +
+                       fmt(0.5 / rate) + " for a command held over one period");
+    }
+    // Sample k of tau sits at t_k + offset; evaluate that signal at the t_k (ends held).
+    const Eigen::Index m = r.t.size();
+    const Eigen::VectorXd shifted = r.t.array() + options.torque_time_offset;
+    const Eigen::VectorXd query = r.t.cwiseMax(shifted(0)).cwiseMin(shifted(m - 1));
+    r.tau = interpolate(shifted, r.tau, query, Interpolation::kLinear);
+    choices.emplace_back("torque_time_offset", fmt(options.torque_time_offset) +
+                                                   " s (torques re-interpolated onto the q time "
+                                                   "stamps)");
+  }
   double cutoff = options.cutoff_hz;
   int trim = options.trim;
   int decimate = options.decimate;
+  SosFilter filter;
   if (options.filter) {
     if (cutoff <= 0.0) cutoff = std::min(20.0, rate / 10.0);
     LowpassOptions lp;
@@ -125,7 +142,7 @@ ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& option
     lp.cutoff_hz = cutoff;
     lp.sample_rate_hz = rate;
     lp.ripple_db = options.ripple_db;
-    SosFilter filter = design_lowpass(lp);
+    filter = design_lowpass(lp);
     // An even-order Chebyshev I design sits at the bottom of its ripple at DC (gain 1/sqrt(1+ε²));
     // identification needs unit DC gain, or every signal would be scaled (q enters non-linearly).
     double dc = 1.0;
@@ -186,7 +203,40 @@ ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& option
   out.record.ddq = take_rows(r.ddq, first, last, decimate);
   out.record.tau = take_rows(r.tau, first, last, decimate);
   out.rate_hz = rate / decimate;
+  if (options.filter_coulomb_columns && options.filter) {
+    const Eigen::MatrixXd pos = (r.dq.array() > 0.0).cast<double>().matrix();
+    const Eigen::MatrixXd neg = (r.dq.array() < 0.0).cast<double>().matrix();
+    out.moving_positive = take_rows(filtfilt(filter, pos), first, last, decimate);
+    out.moving_negative = take_rows(filtfilt(filter, neg), first, last, decimate);
+    choices.emplace_back("coulomb_columns",
+                         "sign(dq) filtered like tau at the full rate (parallel filtering)");
+  }
   return out;
+}
+
+Eigen::MatrixXd processed_regressor(const Model& model, const ParameterLayout& layout,
+                                    bool coupling, const ProcessedRecord& processed) {
+  Eigen::MatrixXd W = stacked_regressor(model, layout, coupling, processed.record);
+  if (processed.moving_positive.size() == 0 || !layout.coulomb) return W;
+  const int n = model.dof();
+  // Column of the first Coulomb term of joint j: after its armature and viscous terms
+  // (joint_columns order, regressor/joint_columns.hpp).
+  const int repeat = layout.asymmetric ? 2 : 1;
+  const int within = (layout.armature ? 1 : 0) + (layout.viscous ? repeat : 0);
+  for (Eigen::Index k = 0; k < processed.record.t.size(); ++k) {
+    for (int j = 0; j < n; ++j) {
+      const Eigen::Index row = k * n + j;
+      const Eigen::Index col = kLinkParams * n + layout.joint_columns() * j + within;
+      const double pos = processed.moving_positive(k, j), neg = processed.moving_negative(k, j);
+      if (layout.asymmetric) {
+        W(row, col) = pos;
+        W(row, col + 1) = -neg;
+      } else {
+        W(row, col) = pos - neg;
+      }
+    }
+  }
+  return W;
 }
 
 namespace {
@@ -246,7 +296,8 @@ IdentificationResult identify(const Model& model, const JointRecord& record,
   const Eigen::VectorXd threshold =
       zero_velocity_threshold(options, r.dq, "removed", result.choices);
   const bool coulomb = options.layout.coulomb;
-  const Eigen::MatrixXd W_full = stacked_regressor(model, options.layout, coupling, r);
+  const Eigen::MatrixXd W_full =
+      processed_regressor(model, options.layout, coupling, result.processed);
   std::vector<Eigen::Index> keep;
   keep.reserve(m * n);
   for (Eigen::Index k = 0; k < m; ++k) {
@@ -334,8 +385,8 @@ ValidationResult validate_torques(const Model& model, const JointRecord& record,
     }
     theta[it - columns.begin()] = values[static_cast<Eigen::Index>(i)];
   }
-  const Eigen::MatrixXd W = stacked_regressor(
-      model, options.layout, options.coupling && !coupled_motors(model).empty(), r);
+  const Eigen::MatrixXd W = processed_regressor(
+      model, options.layout, options.coupling && !coupled_motors(model).empty(), out.processed);
   const Eigen::VectorXd pred = W * theta;
   const Eigen::Index m = r.t.size();
   out.samples = m;

@@ -38,6 +38,18 @@ struct SignalOptions {
   /// Coulomb friction is undefined near dq = 0: rows of joint j with |dq_j| below the threshold are
   /// removed. Empty = auto: 1 % of max|dq_j| per joint. One value = all joints; else n values.
   std::vector<double> zero_velocity;
+  /// The torque logged at time stamp t acts at t + torque_time_offset [s]; the torques are
+  /// re-interpolated (linearly) onto the position time stamps before filtering. A controller that
+  /// logs the command it then holds for one period (zero-order hold, as `dynid simulate` does)
+  /// needs +T/2: central differences centre q̈ on the sample, the held torque half a period later.
+  /// A torque sensor lagging by d needs −d. 0 = as logged.
+  double torque_time_offset = 0.0;
+  /// Filter the Coulomb columns of the regressor (sign(dq), or [dq>0] and −[dq<0]) with the same
+  /// zero-phase filter as tau, from the full-rate velocity (Gautier's parallel filtering applied to
+  /// the one discontinuous column): the filtered torque's smeared Coulomb step at a velocity
+  /// reversal is then matched by the model instead of biasing Fv and Fc. Only with `filter`;
+  /// coupled-motor Coulomb columns stay unfiltered.
+  bool filter_coulomb_columns = false;
 };
 
 enum class IdentificationEstimator { kOls, kWls, kRls };
@@ -56,7 +68,15 @@ struct IdentifyOptions {
 struct ProcessedRecord {
   JointRecord record;    ///< filtered, differentiated, trimmed and decimated
   double rate_hz = 0.0;  ///< sample rate of `record`
+  /// With SignalOptions::filter_coulomb_columns: [dq_j > 0] and [dq_j < 0] at the full rate,
+  /// filtered like tau, trimmed and decimated like `record` (m × n each); else empty.
+  Eigen::MatrixXd moving_positive, moving_negative;
 };
+
+/// Sample-major regressor of a processed record (stacked_regressor), with the Coulomb columns
+/// replaced by their filtered versions when the record carries them (filter_coulomb_columns).
+Eigen::MatrixXd processed_regressor(const Model& model, const ParameterLayout& layout,
+                                    bool coupling, const ProcessedRecord& processed);
 
 /// Everything identify() found, ready to be written as the JSON of DESIGN.md §4.
 struct IdentificationResult {
