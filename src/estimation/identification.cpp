@@ -1,6 +1,7 @@
 #include "dynid/estimation/identification.hpp"
 
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 #include <Eigen/SVD>
@@ -241,6 +242,9 @@ Eigen::MatrixXd processed_regressor(const Model& model, const ParameterLayout& l
 
 namespace {
 
+// Lag-1 residual autocorrelation above which identify() warns that its intervals are optimistic.
+constexpr double kCorrelatedResidualWarning = 0.5;
+
 // Rows of joint j where |dq_j| is below threshold_j, too small for sign(dq_j) to be meaningful, are
 // left out when the layout has Coulomb friction: given values (1 or n), or by default 1 % of
 // max|dq_j| of the processed record (on the TX40 this reproduces FIGAROH's thresholds). Zero
@@ -346,6 +350,38 @@ IdentificationResult identify(const Model& model, const JointRecord& record,
   result.residual_rms = (e2.array() / cnt.array().max(1.0)).sqrt();
   result.joint_relative_error = (e2.array() / y2.array().max(1e-300)).sqrt();
   result.relative_error = e.norm() / y.norm();
+  // Lag-1 autocorrelation of each joint's residual series over consecutive kept samples: the
+  // intervals assume white residuals; filtered data or unmodelled dynamics make them correlated.
+  {
+    Eigen::VectorXd lag = Eigen::VectorXd::Zero(n), prev_e = Eigen::VectorXd::Zero(n);
+    std::vector<Eigen::Index> prev_k(n, -2);
+    for (Eigen::Index i = 0; i < rows; ++i) {
+      const int j = groups[i];
+      const Eigen::Index k = keep[i] / n;
+      if (k == prev_k[j] + 1) lag[j] += e[i] * prev_e[j];
+      prev_k[j] = k;
+      prev_e[j] = e[i];
+    }
+    result.residual_autocorrelation = lag.array() / e2.array().max(1e-300);
+    std::string correlated;
+    double worst = 0.0;
+    for (int j = 0; j < n; ++j) {
+      if (result.residual_autocorrelation[j] > kCorrelatedResidualWarning) {
+        correlated += (correlated.empty() ? "" : ", ") + model.joints[j].name;
+        worst = std::max(worst, result.residual_autocorrelation[j]);
+      }
+    }
+    if (!correlated.empty()) {
+      std::ostringstream w;
+      w << "residuals of " << correlated << " are correlated (lag-1 autocorrelation up to "
+        << std::setprecision(2) << worst
+        << "): the intervals assume white residuals and, for AR(1) residuals, are too narrow by "
+           "about "
+        << std::setprecision(2) << std::sqrt((1.0 + worst) / (1.0 - std::min(worst, 0.999)))
+        << "x (filtered noise or dynamics the model lacks); judge the model on a validation run";
+      result.estimate.summary.warnings.push_back(w.str());
+    }
+  }
   result.condition_number = result.estimate.summary.condition_number;
   if (!(result.condition_number > 0.0)) {
     const Eigen::VectorXd s = Eigen::BDCSVD<Eigen::MatrixXd>(W).singularValues();

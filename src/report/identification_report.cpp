@@ -66,6 +66,7 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
           {"rows", r.rows},
           {"residual_rms", numbers(r.residual_rms)},
           {"joint_relative_error", numbers(r.joint_relative_error)},
+          {"residual_autocorrelation", numbers(r.residual_autocorrelation)},
           {"relative_error", json_number(r.relative_error)},
           {"residual_variance", json_number(e.residual_variance)},
           {"estimator", to_string(e.summary.estimator)},

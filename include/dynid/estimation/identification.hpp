@@ -91,7 +91,10 @@ struct IdentificationResult {
   Eigen::VectorXd residual_rms;             ///< per joint [N·m]
   Eigen::VectorXd joint_relative_error;     ///< per joint ‖e_j‖/‖tau_j‖
   double relative_error = 0.0;              ///< ‖tau − Ŷθ̂‖/‖tau‖ over the rows used
-  std::vector<std::string> warnings;        ///< named, human-readable
+  /// Per joint, lag-1 autocorrelation of the residuals over consecutive samples used (in-memory
+  /// identify only; a named warning above 0.5: the intervals assume white residuals).
+  Eigen::VectorXd residual_autocorrelation;
+  std::vector<std::string> warnings;                         ///< named, human-readable
   std::vector<std::pair<std::string, std::string>> choices;  ///< every processing choice made
   BaseParameters base;        ///< the base set on which the estimate lives
   ProcessedRecord processed;  ///< the data as used
