@@ -242,6 +242,18 @@ Eigen::MatrixXd processed_regressor(const Model& model, const ParameterLayout& l
 
 namespace {
 
+// preprocess() of a run of `model`, after checking that it has one column per joint.
+ProcessedRecord preprocess_run(const Model& model, const JointRecord& record,
+                               const SignalOptions& options,
+                               std::vector<std::pair<std::string, std::string>>& choices) {
+  if (record.q.cols() != model.dof()) {
+    throw Error("the run has " + std::to_string(record.q.cols()) + " joints but model '" +
+                model.name + "' has " + std::to_string(model.dof()) +
+                "; pass the run of this robot or the model it was recorded on");
+  }
+  return preprocess(record, options, choices);
+}
+
 // Lag-1 residual autocorrelation above which identify() warns that its intervals are optimistic.
 constexpr double kCorrelatedResidualWarning = 0.5;
 
@@ -277,12 +289,8 @@ Eigen::VectorXd zero_velocity_threshold(const IdentifyOptions& options, const Ei
 IdentificationResult identify(const Model& model, const JointRecord& record,
                               const IdentifyOptions& options) {
   const int n = model.dof();
-  if (record.q.cols() != n) {
-    throw Error("the run has " + std::to_string(record.q.cols()) + " joints but model '" +
-                model.name + "' has " + std::to_string(n));
-  }
   IdentificationResult result;
-  result.processed = preprocess(record, options.signal, result.choices);
+  result.processed = preprocess_run(model, record, options.signal, result.choices);
   const JointRecord& r = result.processed.record;
   const Eigen::Index m = r.t.size();
   result.samples = m;
@@ -395,12 +403,8 @@ ValidationResult validate_torques(const Model& model, const JointRecord& record,
                                   const std::vector<std::string>& names,
                                   const Eigen::VectorXd& values, const IdentifyOptions& options) {
   const int n = model.dof();
-  if (record.q.cols() != n) {
-    throw Error("the run has " + std::to_string(record.q.cols()) + " joints but model '" +
-                model.name + "' has " + std::to_string(n));
-  }
   ValidationResult out;
-  out.processed = preprocess(record, options.signal, out.choices);
+  out.processed = preprocess_run(model, record, options.signal, out.choices);
   const JointRecord& r = out.processed.record;
   const std::vector<std::string> columns = stacked_regressor_names(
       model, options.layout, options.coupling && !coupled_motors(model).empty());
