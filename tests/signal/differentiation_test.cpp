@@ -11,6 +11,7 @@
 #include "dynid/signal/differentiation.hpp"
 #include "dynid/signal/sample_selection.hpp"
 #include "dynid/signal/sampling_check.hpp"
+#include "support/error_of.hpp"
 
 namespace dynid {
 namespace {
@@ -119,15 +120,7 @@ TEST(SavitzkyGolay, SmoothsNoiseAndDifferentiatesSine) {
   EXPECT_LT(sg_rms, 0.1 * cd_rms);
 }
 
-template <typename F>
-void expect_message(F&& f, const std::string& expected) {
-  try {
-    f();
-    ADD_FAILURE() << "no error, expected: " << expected;
-  } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()), expected);
-  }
-}
+using testing::expect_message;
 
 TEST(SamplingCheck, UniformJitteredAndErrors) {
   const Eigen::VectorXd tu = Eigen::VectorXd::LinSpaced(101, 0.0, 0.1);

@@ -8,21 +8,14 @@
 
 #include "dynid/common/error.hpp"
 #include "dynid/signal/period_averaging.hpp"
+#include "support/error_of.hpp"
 
 namespace dynid {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-template <typename F>
-void expect_message(F&& f, const std::string& expected) {
-  try {
-    f();
-    ADD_FAILURE() << "no error, expected: " << expected;
-  } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()), expected);
-  }
-}
+using testing::expect_message;
 
 // Hand-computed oracle: 3 periods of 2 samples, one channel, plus a trailing partial period.
 TEST(AveragePeriods, SmallCaseByHand) {

@@ -8,6 +8,7 @@
 
 #include "dynid/common/error.hpp"
 #include "dynid/signal/resampling.hpp"
+#include "support/error_of.hpp"
 
 namespace dynid {
 namespace {
@@ -35,15 +36,7 @@ double amplitude(const Eigen::VectorXd& t, const Eigen::VectorXd& y, double f) {
   return c.head<2>().norm();
 }
 
-template <typename F>
-void expect_message(F&& f, const std::string& expected) {
-  try {
-    f();
-    ADD_FAILURE() << "no error, expected: " << expected;
-  } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()), expected);
-  }
-}
+using testing::expect_message;
 
 TEST(Interpolate, LinesExactKnotsExactSplineWithinBound) {
   const Eigen::VectorXd t = jittered_time(400, 1e-3, 21);

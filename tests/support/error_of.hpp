@@ -2,6 +2,7 @@
 
 #include <exception>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -22,6 +23,12 @@ std::string error_of(F&& f) {
   }
   ADD_FAILURE() << "no exception thrown";
   return "";
+}
+
+/// Expects f to throw dynid::Error whose message is exactly `expected`.
+template <class F>
+void expect_message(F&& f, const std::string& expected) {
+  EXPECT_EQ(error_of(std::forward<F>(f)), expected);
 }
 
 }  // namespace dynid::testing
