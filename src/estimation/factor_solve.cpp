@@ -32,6 +32,18 @@ std::string column_list(const EstimationOptions& options, const std::vector<Eige
   return out;
 }
 
+void check_sizes(const Eigen::Ref<const Eigen::MatrixXd>& W,
+                 const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Index p) {
+  if (W.cols() != p) {
+    throw Error("W has " + std::to_string(W.cols()) + " columns but the estimator has " +
+                std::to_string(p) + " parameters; pass one column per parameter");
+  }
+  if (y.size() != W.rows()) {
+    throw Error("y has " + std::to_string(y.size()) + " rows but W has " +
+                std::to_string(W.rows()) + "; pass one observation per row of W");
+  }
+}
+
 void check_names(const EstimationOptions& options, Eigen::Index p) {
   if (!options.names.empty() && static_cast<Eigen::Index>(options.names.size()) != p) {
     throw Error("EstimationOptions::names has " + std::to_string(options.names.size()) +

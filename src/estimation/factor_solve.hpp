@@ -18,6 +18,10 @@ std::string column_name(const EstimationOptions& options, Eigen::Index j);
 /// Comma-separated names of the given columns.
 std::string column_list(const EstimationOptions& options, const std::vector<Eigen::Index>& cols);
 
+/// Throws dynid::Error unless W has p columns and y one entry per row of W.
+void check_sizes(const Eigen::Ref<const Eigen::MatrixXd>& W,
+                 const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Index p);
+
 /// Throws dynid::Error if options.names is neither empty nor of size p.
 void check_names(const EstimationOptions& options, Eigen::Index p);
 

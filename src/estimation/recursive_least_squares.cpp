@@ -96,14 +96,7 @@ void RecursiveLeastSquares::update(const Eigen::Ref<const Eigen::VectorXd>& d, d
 
 void RecursiveLeastSquares::update(const Eigen::Ref<const Eigen::MatrixXd>& W,
                                    const Eigen::Ref<const Eigen::VectorXd>& y) {
-  if (W.cols() != parameters_) {
-    throw Error("W has " + std::to_string(W.cols()) + " columns but the estimator has " +
-                std::to_string(parameters_) + " parameters; pass one column per parameter");
-  }
-  if (y.size() != W.rows()) {
-    throw Error("y has " + std::to_string(y.size()) + " rows but W has " +
-                std::to_string(W.rows()) + "; pass one observation per row of W");
-  }
+  estimation_detail::check_sizes(W, y, parameters_);
   if (options_.record_history) history_.reserve(history_.size() + W.rows() * parameters_);
   // A row of a column-major W is strided; copy it into the workspace (no allocation per sample).
   for (Eigen::Index i = 0; i < W.rows(); ++i) {

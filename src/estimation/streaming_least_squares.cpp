@@ -111,14 +111,7 @@ std::vector<Eigen::Index> StreamingLeastSquares::group_rows() const {
 
 void StreamingLeastSquares::check_block(const Eigen::Ref<const Eigen::MatrixXd>& W,
                                         const Eigen::Ref<const Eigen::VectorXd>& y) const {
-  if (W.cols() != parameters_) {
-    throw Error("W has " + std::to_string(W.cols()) + " columns but the estimator has " +
-                std::to_string(parameters_) + " parameters; pass one column per parameter");
-  }
-  if (y.size() != W.rows()) {
-    throw Error("y has " + std::to_string(y.size()) + " rows but W has " +
-                std::to_string(W.rows()) + "; pass one observation per row of W");
-  }
+  estimation_detail::check_sizes(W, y, parameters_);
   if (!W.allFinite()) {
     for (Eigen::Index i = 0; i < W.rows(); ++i) {
       if (!W.row(i).allFinite()) {
