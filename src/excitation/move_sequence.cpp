@@ -28,14 +28,24 @@ void check_way_points(const Eigen::MatrixXd& way_points, const std::string& name
   if (!way_points.allFinite()) throw Error(name + ": NaN or Inf; give finite joint positions");
 }
 
-Move trapezoid_move(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
-                    const Eigen::VectorXd& v_max, const Eigen::VectorXd& a_max, int index) {
-  const Eigen::Index n = from.size();
+namespace {
+
+// A move from `from` to `to` with no acceleration phases yet (filled in by its profile).
+Move rest_to_rest(const Eigen::VectorXd& from, const Eigen::VectorXd& to) {
   Move m;
   m.q_start = from;
   m.distance = to - from;
-  m.acceleration = Eigen::VectorXd::Zero(n);
-  m.accel_time = Eigen::VectorXd::Zero(n);
+  m.acceleration = Eigen::VectorXd::Zero(from.size());
+  m.accel_time = Eigen::VectorXd::Zero(from.size());
+  return m;
+}
+
+}  // namespace
+
+Move trapezoid_move(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                    const Eigen::VectorXd& v_max, const Eigen::VectorXd& a_max, int index) {
+  const Eigen::Index n = from.size();
+  Move m = rest_to_rest(from, to);
   double T = 0.0;
   for (Eigen::Index j = 0; j < n; ++j) {
     const double D = std::abs(m.distance[j]);
@@ -69,11 +79,7 @@ Move trapezoid_move(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
 Move bang_bang_move(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
                     const Eigen::VectorXd& a_max, int index) {
   const Eigen::Index n = from.size();
-  Move m;
-  m.q_start = from;
-  m.distance = to - from;
-  m.acceleration = Eigen::VectorXd::Zero(n);
-  m.accel_time = Eigen::VectorXd::Zero(n);
+  Move m = rest_to_rest(from, to);
   double T = 0.0;
   for (Eigen::Index j = 0; j < n; ++j)
     T = std::max(T, 2.0 * std::sqrt(std::abs(m.distance[j]) / a_max[j]));
