@@ -240,6 +240,16 @@ Eigen::MatrixXd processed_regressor(const Model& model, const ParameterLayout& l
   return W;
 }
 
+Eigen::VectorXd given_zero_velocity(const std::vector<double>& zero_velocity, int n) {
+  if (zero_velocity.empty()) return Eigen::VectorXd();
+  if (zero_velocity.size() == 1) return Eigen::VectorXd::Constant(n, zero_velocity[0]);
+  if (static_cast<int>(zero_velocity.size()) == n) {
+    return Eigen::Map<const Eigen::VectorXd>(zero_velocity.data(), n);
+  }
+  throw UsageError("--zero-velocity takes 1 or " + std::to_string(n) + " values, got " +
+                   std::to_string(zero_velocity.size()));
+}
+
 namespace {
 
 // preprocess() of a run of `model`, after checking that it has one column per joint.
@@ -267,17 +277,8 @@ Eigen::VectorXd zero_velocity_threshold(const IdentifyOptions& options, const Ei
   const auto n = dq.cols();
   Eigen::VectorXd threshold = Eigen::VectorXd::Zero(n);
   if (!options.layout.coulomb) return threshold;
-  const auto& zv = options.signal.zero_velocity;
-  if (zv.empty()) {
-    threshold = 0.01 * dq.cwiseAbs().colwise().maxCoeff().transpose();
-  } else if (zv.size() == 1) {
-    threshold.setConstant(zv[0]);
-  } else if (static_cast<Eigen::Index>(zv.size()) == n) {
-    threshold = Eigen::Map<const Eigen::VectorXd>(zv.data(), n);
-  } else {
-    throw UsageError("--zero-velocity takes 1 or " + std::to_string(n) + " values, got " +
-                     std::to_string(zv.size()));
-  }
+  threshold = given_zero_velocity(options.signal.zero_velocity, static_cast<int>(n));
+  if (threshold.size() == 0) threshold = 0.01 * dq.cwiseAbs().colwise().maxCoeff().transpose();
   std::ostringstream s;
   s << "rows with |dq_j| < [" << threshold.transpose() << "] " << verb << " (Coulomb friction)";
   choices.emplace_back("zero_velocity", s.str());

@@ -59,8 +59,15 @@ std::vector<std::vector<Eigen::Index>> joint_base_columns(const Model& model,
 
 // Everything one worker needs to turn a chunk of samples into accumulated rows.
 struct Worker {
-  Worker(const Model& model, int rank, const StreamingOptions& lsq_options)
-      : ws(model), lsq(rank, model.dof(), lsq_options) {}
+  Worker(const Model& model, const ParameterLayout& layout, int rank,
+         const StreamingOptions& lsq_options)
+      : ws(model),
+        lsq(rank, model.dof(), lsq_options),
+        Y(model.dof(), layout.columns(model.dof())),
+        q(model.dof()),
+        dq(model.dof()),
+        ddq(model.dof()),
+        w(rank) {}
   Workspace ws;
   StreamingLeastSquares lsq;
   Eigen::MatrixXd Y;
@@ -122,17 +129,10 @@ void process_block(const StreamSetup& s, Worker& w, const Eigen::MatrixXd& block
 // have stopped, so no thread outlives the call.
 StreamingLeastSquares accumulate(const StreamSetup& s, const StreamingOptions& lsq_options,
                                  int threads, Eigen::Index& samples) {
-  const int n = s.model->dof();
   const int rank = s.base->rank;
   std::vector<std::unique_ptr<Worker>> workers;
   for (int t = 0; t < threads; ++t) {
-    workers.push_back(std::make_unique<Worker>(*s.model, rank, lsq_options));
-    Worker& w = *workers.back();
-    w.Y.resize(n, s.layout->columns(n));
-    w.q.resize(n);
-    w.dq.resize(n);
-    w.ddq.resize(n);
-    w.w.resize(rank);
+    workers.push_back(std::make_unique<Worker>(*s.model, *s.layout, rank, lsq_options));
   }
   CsvChunkReader reader(s.path);
   samples = 0;
@@ -271,15 +271,8 @@ IdentificationResult identify_stream(const Model& model, const std::string& path
     s.cddq = resolve_joint_columns(columns, joints, "ddq", path);
     s.ctau = resolve_joint_columns(columns, joints, "tau", path);
   }
-  s.threshold = Eigen::VectorXd::Zero(n);
-  const auto& zv = options.signal.zero_velocity;
-  if (zv.size() == 1) s.threshold.setConstant(zv[0]);
-  if (static_cast<int>(zv.size()) == n) {
-    s.threshold = Eigen::Map<const Eigen::VectorXd>(zv.data(), n);
-  }
-  if (!zv.empty() && zv.size() != 1 && static_cast<int>(zv.size()) != n) {
-    throw UsageError("--zero-velocity takes 1 or " + std::to_string(n) + " values");
-  }
+  s.threshold = given_zero_velocity(options.signal.zero_velocity, n);
+  if (s.threshold.size() == 0) s.threshold = Eigen::VectorXd::Zero(n);  // no automatic rule here
   s.active = joint_base_columns(model, options.layout, result.base);
   s.active_full.resize(n);
   s.inactive_full.resize(n);

@@ -134,6 +134,27 @@ TEST(StreamingIdentification, NanSampleNamesTheDataRowWithAnyThreadCount) {
   EXPECT_THROW(identify_stream(model, path, {}, o, {-1, true}), UsageError);
 }
 
+// A zero-velocity list that is neither 1 nor n values is refused alike in memory and streaming.
+TEST(StreamingIdentification, ZeroVelocityNeedsOneOrOnePerJoint) {
+  const Model model = load_robot("puma560");
+  const std::string path = write_run(model, 200, 0.3, "stream_zv.csv");
+  IdentifyOptions o;
+  o.signal.filter = false;
+  o.signal.zero_velocity = {0.1, 0.2};
+  const std::string expected = "--zero-velocity takes 1 or 6 values, got 2";
+  for (int mode = 0; mode < 2; ++mode) {
+    try {
+      mode ? identify_stream(model, path, {}, o)
+           : identify(model, read_joint_record(path, model), o);
+      ADD_FAILURE() << "no error";
+    } catch (const UsageError& e) {
+      EXPECT_EQ(std::string(e.what()), expected);
+    }
+  }
+  EXPECT_EQ(given_zero_velocity({0.5}, 3), Eigen::Vector3d::Constant(0.5));
+  EXPECT_EQ(given_zero_velocity({}, 3).size(), 0);
+}
+
 TEST(StreamingIdentification, RefusesFilteringAndMissingDerivatives) {
   const Model model = load_robot("puma560");
   const std::string path = write_run(model, 100);

@@ -52,6 +52,11 @@ struct SignalOptions {
   bool filter_coulomb_columns = false;
 };
 
+/// Per-joint zero-velocity thresholds [rad/s or m/s] from SignalOptions::zero_velocity: one value
+/// for all n joints, or n values; empty gives an empty vector (the caller's automatic rule).
+/// Throws dynid::UsageError for any other count.
+Eigen::VectorXd given_zero_velocity(const std::vector<double>& zero_velocity, int n);
+
 enum class IdentificationEstimator { kOls, kWls, kRls };
 
 /// Options of identify().

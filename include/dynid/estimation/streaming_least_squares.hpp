@@ -101,7 +101,6 @@ class StreamingLeastSquares {
   int groups() const { return static_cast<int>(groups_.size()); }  ///< G
   /// Rows added per group.
   std::vector<Eigen::Index> group_rows() const;
-  const StreamingOptions& options() const { return options_; }  ///< as constructed
   /// Forgets all rows (keeps sizes).
   void reset();
 
