@@ -8,7 +8,7 @@
 namespace dynid {
 
 /// Folder holding the built-in robots: $DYNID_ROBOTS_DIR if set and non-empty, else
-/// DYNID_SOURCE_DIR "/examples/robots" (compile definition of dynid_lib).
+/// DYNID_SOURCE_DIR "/examples/robots" (compile definition of robots.cpp).
 std::string builtin_robots_dir();
 
 /// Short names of the built-in robots (file stems of the *.urdf, *.yaml, *.yml files in
