@@ -1,4 +1,4 @@
-// `dynid demo`: the whole identification loop on a simulated robot (report/demo.hpp).
+// `dynid demo`: the whole identification loop on a simulated robot (workflow/demo.hpp).
 #include <chrono>
 #include <ctime>
 #include <iostream>
@@ -6,7 +6,7 @@
 #include <string>
 
 #include "commands.hpp"
-#include "dynid/report/demo.hpp"
+#include "dynid/workflow/demo.hpp"
 
 namespace dynid::cli {
 namespace {

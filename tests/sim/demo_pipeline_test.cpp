@@ -9,7 +9,7 @@
 
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/model/robots.hpp"
-#include "dynid/report/demo.hpp"
+#include "dynid/workflow/demo.hpp"
 
 namespace dynid {
 namespace {

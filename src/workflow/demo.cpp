@@ -1,4 +1,4 @@
-#include "dynid/report/demo.hpp"
+#include "dynid/workflow/demo.hpp"
 
 #include <cstdio>
 #include <filesystem>
