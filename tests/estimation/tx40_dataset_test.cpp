@@ -1,4 +1,4 @@
-// The real Staubli TX40 run of ../shared/datasets/staubli-tx40 (SOURCE.md): identification with the
+// The real Staubli TX40 run of examples/staubli-tx40/dataset (SOURCE.md): identification with the
 // default signal processing must reproduce the published friction values (config/T40X_config.yaml)
 // and FIGAROH's base parameters (results/TX40_bp_5.csv) within a few percent, with about 5 %
 // relative torque error. Skips when the data set is absent.
@@ -18,7 +18,8 @@
 namespace dynid {
 namespace {
 
-const std::string kData = std::string(DYNID_SHARED_DIR) + "/datasets/staubli-tx40";
+// The copy shipped in the repository (examples/staubli-tx40/dataset).
+const std::string kData = std::string(DYNID_SOURCE_DIR) + "/examples/staubli-tx40/dataset";
 
 // FIGAROH's OLS value of each base parameter, keyed by the first token of its expression.
 std::map<std::string, double> figaroh_ols() {
