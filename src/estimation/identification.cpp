@@ -308,6 +308,7 @@ IdentificationResult identify(const Model& model, const JointRecord& record,
 
   const Eigen::VectorXd threshold =
       zero_velocity_threshold(options, r.dq, "removed", result.choices);
+  result.zero_velocity_threshold = threshold;
   const bool coulomb = options.layout.coulomb;
   const Eigen::MatrixXd W_full =
       processed_regressor(model, options.layout, coupling, result.processed);
@@ -438,6 +439,7 @@ ValidationResult validate_torques(const Model& model, const JointRecord& record,
   // model are left out the same way (their sign(dq) is noise), and reported apart.
   const Eigen::VectorXd threshold =
       zero_velocity_threshold(options, r.dq, "left out of the error statistics", out.choices);
+  out.zero_velocity_threshold = threshold;
   const Eigen::MatrixXd e = r.tau - out.predicted;
   Eigen::VectorXd e2 = Eigen::VectorXd::Zero(n), y2 = Eigen::VectorXd::Zero(n),
                   cnt = Eigen::VectorXd::Zero(n);
@@ -451,6 +453,12 @@ ValidationResult validate_torques(const Model& model, const JointRecord& record,
   }
   out.rows = static_cast<Eigen::Index>(cnt.sum());
   out.rows_excluded = m * n - out.rows;
+  out.joint_rows_excluded = (static_cast<double>(m) - cnt.array()).round().cast<int>();
+  out.rms_all_rows = (e.colwise().squaredNorm().transpose() / static_cast<double>(m)).cwiseSqrt();
+  out.relative_error_all_rows_joint = (e.colwise().squaredNorm().array() /
+                                       r.tau.colwise().squaredNorm().array().max(1e-300))
+                                          .sqrt()
+                                          .transpose();
   if (out.rows == 0) {
     throw Error(
         "every sample is below the zero-velocity threshold; the run does not move, or "

@@ -321,6 +321,7 @@ IdentificationResult identify_stream(const Model& model, const std::string& path
                               "streaming (constant memory), no filtering, dq and ddq as given");
   result.choices.emplace_back("accumulation", accumulation);
   result.choices.emplace_back("threads", std::to_string(threads) + " workers + 1 reader");
+  result.zero_velocity_threshold = s.threshold;
   result.samples = samples;
   result.rows = lsq.rows();
   result.residual_rms = result.estimate.group_rms;

@@ -1,11 +1,14 @@
 #include "dynid/report/identification_report.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 
 #include "dynid/common/error.hpp"
+#include "dynid/io/csv_writer.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/version.hpp"
 
@@ -23,6 +26,19 @@ nlohmann::json numbers(const Eigen::VectorXd& v) {
   nlohmann::json a = nlohmann::json::array();
   for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(json_number(v[i]));
   return a;
+}
+
+// Width of the joint-name column of a table: the longest name, at least `minimum`.
+int name_width(const Model& model, int minimum) {
+  int w = minimum;
+  for (const Joint& j : model.joints) w = std::max(w, static_cast<int>(j.name.size()));
+  return w;
+}
+
+// True for a base parameter that is one standard parameter, unregrouped ("XY2 = XY2").
+bool is_identity(const std::string& expression) {
+  const auto eq = expression.find(" = ");
+  return eq != std::string::npos && expression.substr(0, eq) == expression.substr(eq + 3);
 }
 
 std::string line(const char* format, ...) __attribute__((format(printf, 1, 2)));
@@ -68,6 +84,7 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
           {"joint_relative_error", numbers(r.joint_relative_error)},
           {"residual_autocorrelation", numbers(r.residual_autocorrelation)},
           {"relative_error", json_number(r.relative_error)},
+          {"zero_velocity_threshold", numbers(r.zero_velocity_threshold)},
           {"residual_variance", json_number(e.residual_variance)},
           {"estimator", to_string(e.summary.estimator)},
           {"unidentifiable", r.unidentifiable},
@@ -80,27 +97,29 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
 std::string identification_table(const Model& model, const IdentificationResult& r) {
   const Estimate& e = r.estimate;
   std::ostringstream s;
-  s << line("%-10s %14s %12s %9s   %-29s\n", "parameter", "value", "std", "%std",
+  int pw = 10;
+  for (const auto& name : r.names) pw = std::max(pw, static_cast<int>(name.size()));
+  s << line("%-*s %14s %12s %9s   %-29s\n", pw, "parameter", "value", "std", "%std",
             (line("%.4g", 100 * e.confidence_level) + "% confidence interval").c_str());
   for (size_t i = 0; i < r.names.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
-    s << line("%-10s %14.6g %12.4g %9.2f   [%.6g, %.6g]\n", r.names[i].c_str(), e.x[k],
+    s << line("%-*s %14.6g %12.4g %9.2f   [%.6g, %.6g]\n", pw, r.names[i].c_str(), e.x[k],
               e.std_dev[k], e.relative_std_percent[k], e.ci_lower[k], e.ci_upper[k]);
   }
   s << line(
       "\nrank %d, condition number %.4g, %ld samples, %ld equations, relative error %.2f %%\n",
       r.rank, r.condition_number, static_cast<long>(r.samples), static_cast<long>(r.rows),
       100 * r.relative_error);
+  const int w = name_width(model, 12);
   for (int j = 0; j < model.dof(); ++j) {
-    s << line("  %-12s residual RMS %.4g, relative error %.2f %%\n", model.joints[j].name.c_str(),
+    s << line("  %-*s residual RMS %.4g, relative error %.2f %%\n", w, model.joints[j].name.c_str(),
               r.residual_rms[j], 100 * r.joint_relative_error[j]);
   }
   for (const auto& w : r.warnings) s << "warning: " << w << '\n';
   return s.str();
 }
 
-void read_identified_parameters(const std::string& path, std::vector<std::string>& names,
-                                Eigen::VectorXd& values, nlohmann::json& options_used) {
+IdentifiedResultFile read_identification_result(const std::string& path) {
   std::ifstream f(path);
   if (!f)
     throw Error("cannot open parameter file '" + path +
@@ -111,21 +130,54 @@ void read_identified_parameters(const std::string& path, std::vector<std::string
   } catch (const std::exception& ex) {
     throw Error("'" + path + "' is not valid JSON (" + std::string(ex.what()) + ")");
   }
-  if (!j.contains("parameters") || !j["parameters"].is_array()) {
+  if (!j.is_object() || !j.contains("parameters") || !j["parameters"].is_array()) {
     throw Error("'" + path + "' has no 'parameters' list; give the result.json of dynid identify");
   }
-  names.clear();
-  values.resize(static_cast<Eigen::Index>(j["parameters"].size()));
+  IdentifiedResultFile out;
+  out.values.resize(static_cast<Eigen::Index>(j["parameters"].size()));
   for (size_t i = 0; i < j["parameters"].size(); ++i) {
     const auto& p = j["parameters"][i];
-    if (!p.contains("name") || !p.contains("value") || !p["value"].is_number()) {
+    if (!p.is_object() || !p.contains("name") || !p["name"].is_string() || !p.contains("value") ||
+        !p["value"].is_number()) {
       throw Error("'" + path + "': parameters[" + std::to_string(i) +
                   "] needs a name and a numeric value");
     }
-    names.push_back(p["name"].get<std::string>());
-    values[static_cast<Eigen::Index>(i)] = p["value"].get<double>();
+    out.names.push_back(p["name"].get<std::string>());
+    out.values[static_cast<Eigen::Index>(i)] = p["value"].get<double>();
   }
-  options_used = j.value("options", nlohmann::json::object());
+  const auto options = j.find("options");
+  out.options = options != j.end() && options->is_object() ? *options : nlohmann::json::object();
+  const auto model = j.find("model");
+  if (model != j.end() && model->is_object()) {
+    if (model->contains("name") && (*model)["name"].is_string()) {
+      out.robot = (*model)["name"].get<std::string>();
+    }
+    if (model->contains("joints") && (*model)["joints"].is_array()) {
+      for (const auto& name : (*model)["joints"]) {
+        if (name.is_string()) out.joints.push_back(name.get<std::string>());
+      }
+    }
+  }
+  const auto threshold = j.find("zero_velocity_threshold");
+  if (threshold != j.end() && threshold->is_array()) {
+    for (const auto& x : *threshold) {
+      if (!x.is_number() || !std::isfinite(x.get<double>()) || x.get<double>() < 0.0) {
+        throw Error("'" + path +
+                    "': zero_velocity_threshold must be non-negative numbers; write the file "
+                    "with dynid identify");
+      }
+      out.zero_velocity_threshold.push_back(x.get<double>());
+    }
+  }
+  return out;
+}
+
+void read_identified_parameters(const std::string& path, std::vector<std::string>& names,
+                                Eigen::VectorXd& values, nlohmann::json& options_used) {
+  IdentifiedResultFile file = read_identification_result(path);
+  names = std::move(file.names);
+  values = std::move(file.values);
+  options_used = std::move(file.options);
 }
 
 nlohmann::json base_parameters_to_json(const BaseParameters& base) {
@@ -143,7 +195,15 @@ std::string base_parameters_text(const BaseParameters& base) {
   std::ostringstream s;
   s << base.rank << " base parameters (numerical Gautier-Khalil method, " << base.samples
     << " random states):\n";
-  for (int i = 0; i < base.rank; ++i) s << "  " << base.expressions[i] << '\n';
+  std::string alone;
+  for (int i = 0; i < base.rank; ++i) {
+    if (is_identity(base.expressions[i])) {
+      alone += ' ' + base.names[i];
+    } else {
+      s << "  " << base.expressions[i] << '\n';
+    }
+  }
+  if (!alone.empty()) s << "identifiable alone (not regrouped):" << alone << '\n';
   s << "no effect on the dynamics (unidentifiable):";
   for (const auto& n : base.unidentifiable_names()) s << ' ' << n;
   s << '\n';
@@ -155,7 +215,10 @@ nlohmann::json validation_to_json(const Model& model, const ValidationResult& v)
   for (int j = 0; j < model.dof(); ++j) {
     joints.push_back({{"name", model.joints[j].name},
                       {"rms", json_number(v.rms[j])},
-                      {"relative_error", json_number(v.relative_error[j])}});
+                      {"relative_error", json_number(v.relative_error[j])},
+                      {"rms_all_rows", json_number(v.rms_all_rows[j])},
+                      {"relative_error_all_rows", json_number(v.relative_error_all_rows_joint[j])},
+                      {"rows_left_out", v.joint_rows_excluded[j]}});
   }
   nlohmann::json choices = nlohmann::json::object();
   for (const auto& [key, value] : v.choices) choices[key] = value;
@@ -165,26 +228,63 @@ nlohmann::json validation_to_json(const Model& model, const ValidationResult& v)
           {"samples", v.samples},
           {"rows", v.rows},
           {"rows_excluded_zero_velocity", v.rows_excluded},
+          {"rows_left_out",
+           {{"rule",
+             "rows of joint j with |dq_j| < zero_velocity_threshold[j] are left out of "
+             "relative_error, rms and joints[].relative_error (Coulomb friction: sign(dq) is "
+             "undefined there), as identify left them out of the fit; the *_all_rows figures "
+             "keep every row"},
+            {"zero_velocity_threshold", numbers(v.zero_velocity_threshold)},
+            {"rows", v.rows_excluded}}},
           {"choices", choices},
           {"version", kVersion}};
 }
 
 std::string validation_table(const Model& model, const ValidationResult& v) {
   std::ostringstream s;
+  const int w = name_width(model, 5);
+  const long all = static_cast<long>(v.rows + v.rows_excluded);
+  s << line("%-*s %12s %15s %21s %10s\n", w + 2, "joint", "RMS [N m]", "rel. error",
+            "rel. error (moving)", "left out");
   for (int j = 0; j < model.dof(); ++j) {
-    s << line("  %-12s torque RMS %.4g, relative error %.2f %%\n", model.joints[j].name.c_str(),
-              v.rms[j], 100 * v.relative_error[j]);
+    s << line("  %-*s %12.4g %13.2f %% %19.2f %% %10d\n", w, model.joints[j].name.c_str(),
+              v.rms_all_rows[j], 100 * v.relative_error_all_rows_joint[j],
+              100 * v.relative_error[j], v.joint_rows_excluded[j]);
   }
-  s << line("all joints: relative error %.2f %% over %ld samples\n", 100 * v.relative_error_all,
-            static_cast<long>(v.samples));
+  s << line("relative torque error over every row: %.2f %% (%ld samples, %ld joint rows)\n",
+            100 * v.relative_error_all_rows, static_cast<long>(v.samples), all);
   if (v.rows_excluded > 0) {
+    std::ostringstream t;
+    t << v.zero_velocity_threshold.transpose();
     s << line(
-        "  (%ld of %ld joint rows with |dq| below the zero-velocity threshold left out, as in "
-        "identify; with them: %.2f %%; --zero-velocity 0 compares every row)\n",
-        static_cast<long>(v.rows_excluded), static_cast<long>(v.rows + v.rows_excluded),
-        100 * v.relative_error_all_rows);
+        "relative torque error without near-still rows: %.2f %% (%ld of %ld joint rows with "
+        "|dq_j| below [%s] left out, as identify left them out of the fit; --zero-velocity 0 "
+        "keeps every row)\n",
+        100 * v.relative_error_all, static_cast<long>(v.rows_excluded), all, t.str().c_str());
   }
   return s.str();
+}
+
+void write_validation_predictions(const std::string& path, const ValidationResult& v) {
+  const JointRecord& r = v.processed.record;
+  const Eigen::Index m = r.t.size();
+  const Eigen::Index n = r.tau.cols();
+  std::vector<std::string> columns = {"t"};
+  Eigen::MatrixXd data(m, 1 + 4 * n);
+  data.col(0) = r.t;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const std::string k = std::to_string(j + 1);
+    for (const char* prefix : {"tau", "tau_pred", "residual", "left_out"}) {
+      columns.push_back(prefix + k);
+    }
+    data.col(1 + 4 * j) = r.tau.col(j);
+    data.col(2 + 4 * j) = v.predicted.col(j);
+    data.col(3 + 4 * j) = r.tau.col(j) - v.predicted.col(j);
+    const double threshold =
+        j < v.zero_velocity_threshold.size() ? v.zero_velocity_threshold[j] : 0;
+    data.col(4 + 4 * j) = (r.dq.col(j).array().abs() < threshold).cast<double>();
+  }
+  write_csv(path, columns, data);
 }
 
 namespace {

@@ -172,6 +172,9 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
   vrec.tau = vrun.tau;
   IdentifyOptions vo = io;
   vo.signal.trim = -1;
+  // The rows left out of the second figure are those below the thresholds the fit used.
+  const Eigen::VectorXd& fit_threshold = out.identification.zero_velocity_threshold;
+  vo.signal.zero_velocity.assign(fit_threshold.data(), fit_threshold.data() + fit_threshold.size());
   out.validation =
       validate_torques(model, vrec, out.identification.names, out.identification.estimate.x, vo);
   write_json(file("validation.json"), validation_to_json(model, out.validation));
@@ -190,16 +193,21 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
     t << line(out.identification.names[i], out.truth[i], out.identification.estimate.x[i],
               out.identification.estimate.relative_std_percent[i], in);
   }
-  char buf[256];
+  const ValidationResult& v = out.validation;
+  char buf[512];
   std::snprintf(buf, sizeof(buf),
                 "truth inside the interval for %d of %d; excitation condition number %.4g "
-                "(constraints %s)\nidentification relative torque error %.2f %%; validation on a "
-                "trapezoidal move: relative torque error %.2f %%, RMS per joint:",
+                "(constraints %s)\nidentification: relative torque error %.2f %% on the %ld "
+                "joint rows fitted\nvalidation on a trapezoidal move: relative torque error over "
+                "every row %.2f %%; without the %ld of %ld near-still rows (|dq_j| below the "
+                "fit's thresholds) %.2f %%\nvalidation RMS per joint, every row:",
                 inside, out.identification.rank, out.excitation.condition_number,
                 out.excitation.constraints_satisfied ? "satisfied" : "violated",
-                100 * out.identification.relative_error, 100 * out.validation.relative_error_all);
+                100 * out.identification.relative_error, static_cast<long>(out.identification.rows),
+                100 * v.relative_error_all_rows, static_cast<long>(v.rows_excluded),
+                static_cast<long>(v.rows + v.rows_excluded), 100 * v.relative_error_all);
   t << buf;
-  for (int j = 0; j < n; ++j) t << ' ' << out.validation.rms[j];
+  for (int j = 0; j < n; ++j) t << ' ' << v.rms_all_rows[j];
   t << " N·m\n";
   out.table = t.str();
   progress("6/6 done; files in " + o.out_dir);

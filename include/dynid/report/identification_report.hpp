@@ -23,8 +23,23 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
 /// per-joint residuals and warnings.
 std::string identification_table(const Model& model, const IdentificationResult& result);
 
-/// Reads `parameters[].name/value` of a result JSON (identification_to_json). Throws dynid::Error
-/// naming the file when the key is missing or malformed.
+/// What `dynid validate` takes from a result JSON written by identification_to_json.
+struct IdentifiedResultFile {
+  std::vector<std::string> names;   ///< base parameter names, in file order
+  Eigen::VectorXd values;           ///< their values
+  nlohmann::json options;           ///< `options` as given to identify (empty object if absent)
+  std::string robot;                ///< `model.name`; empty when the file has none
+  std::vector<std::string> joints;  ///< `model.joints`; empty when the file has none
+  /// `zero_velocity_threshold` per joint as identify used it; empty in files written before it
+  /// was stored.
+  std::vector<double> zero_velocity_threshold;
+};
+
+/// Reads a result JSON (identification_to_json). Throws dynid::Error naming the file when
+/// `parameters` is missing or malformed, or a stored threshold is not a non-negative number.
+IdentifiedResultFile read_identification_result(const std::string& path);
+
+/// Reads `parameters[].name/value` and `options` of a result JSON (read_identification_result).
 void read_identified_parameters(const std::string& path, std::vector<std::string>& names,
                                 Eigen::VectorXd& values, nlohmann::json& options_used);
 
@@ -33,9 +48,24 @@ void read_identified_parameters(const std::string& path, std::vector<std::string
 nlohmann::json base_parameters_to_json(const BaseParameters& base);
 std::string base_parameters_text(const BaseParameters& base);
 
-/// `dynid validate` JSON: `joints` (name, rms, relative_error), `relative_error`, `samples`.
+/// `dynid validate` JSON: `joints` (name, rms, relative_error on the rows compared; rms_all_rows,
+/// relative_error_all_rows, rows_left_out), `relative_error` (rows compared: near-still rows left
+/// out as identify did), `relative_error_all_rows` (every row), `samples`, `rows`,
+/// `rows_excluded_zero_velocity`, `rows_left_out` {rule, zero_velocity_threshold, rows},
+/// `choices`, `version`.
 nlohmann::json validation_to_json(const Model& model, const ValidationResult& v);
+
+/// The validation table: per joint RMS and relative error over every row, relative error over the
+/// moving rows and rows left out; then the error over every row (headline) and, when rows were
+/// left out, the error without them, labelled.
 std::string validation_table(const Model& model, const ValidationResult& v);
+
+/// `dynid validate --predicted`: CSV with `t` and, per joint j (1-based), `tau<j>` (measured,
+/// after the same filtering as identify), `tau_pred<j>` (predicted), `residual<j>` = tau − tau_pred
+/// [N·m], and `left_out<j>` (1 where |dq_j| is below the zero-velocity threshold, i.e. the row is
+/// left out of the near-still-free error, else 0), one line per processed sample. Written
+/// atomically; throws dynid::Error as write_csv.
+void write_validation_predictions(const std::string& path, const ValidationResult& v);
 
 /// `dynid validate --mode simulation` JSON: `joints` (name, position {rms, max, mean, std,
 /// skewness, kurtosis, ks_statistic, ks_p_value}, torque {same}), `samples`, `version`.
