@@ -1,5 +1,6 @@
 #include "dynid/io/csv_reader.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -36,13 +37,25 @@ std::string read_whole_file(const std::string& path) {
   return text;
 }
 
+CsvTable parse_csv_text(std::string_view text, const std::string& source, bool header);
+
 }  // namespace
 
 CsvTable read_csv(const std::string& path) {
-  return parse_csv(read_whole_file(path), path);
+  return parse_csv_text(read_whole_file(path), path, true);
+}
+
+CsvTable read_csv_without_header(const std::string& path) {
+  return parse_csv_text(read_whole_file(path), path, false);
 }
 
 CsvTable parse_csv(std::string_view text, const std::string& source) {
+  return parse_csv_text(text, source, true);
+}
+
+namespace {
+
+CsvTable parse_csv_text(std::string_view text, const std::string& source, bool header) {
   using namespace csv_detail;
   CsvTable table;
   table.source = source;
@@ -66,9 +79,19 @@ CsvTable parse_csv(std::string_view text, const std::string& source) {
   };
 
   bool have_header = false;
+  const char* const before_first = p;
+  const long line_before_first = line;
   while (next_line()) {
     if (is_skippable(b, e)) continue;
-    table.columns = parse_header(b, e, source, line);
+    if (header) {
+      table.columns = parse_header(b, e, source, line);
+    } else {
+      // Columns named by position; the first line is read again below as data.
+      const auto fields = std::count(b, e, ',') + 1;
+      for (long c = 1; c <= fields; ++c) table.columns.push_back(std::to_string(c));
+      p = before_first;
+      line = line_before_first;
+    }
     have_header = true;
     break;
   }
@@ -90,8 +113,18 @@ CsvTable parse_csv(std::string_view text, const std::string& source) {
   Eigen::Index rows = 0;
   while (next_line()) {
     if (is_skippable(b, e)) continue;
-    parse_row(b, e, table.columns, buffer.data() + rows * n, 1, source, line,
-              static_cast<long>(rows) + 1, !terminated);
+    if (!header && rows == 0) {
+      try {
+        parse_row(b, e, table.columns, buffer.data(), 1, source, line, 1, !terminated);
+      } catch (const Error& ex) {
+        throw Error(std::string(ex.what()) +
+                    " (the file was read without a header because --columns names columns by "
+                    "position; if its first line is a header, name those columns instead)");
+      }
+    } else {
+      parse_row(b, e, table.columns, buffer.data() + rows * n, 1, source, line,
+                static_cast<long>(rows) + 1, !terminated);
+    }
     table.lines.push_back(line);
     ++rows;
   }
@@ -102,4 +135,5 @@ CsvTable parse_csv(std::string_view text, const std::string& source) {
   return table;
 }
 
+}  // namespace
 }  // namespace dynid

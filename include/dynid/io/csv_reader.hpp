@@ -21,4 +21,9 @@ CsvTable read_csv(const std::string& path);
 /// Same as read_csv on text already in memory; `source` names it in error messages.
 CsvTable parse_csv(std::string_view text, const std::string& source);
 
+/// read_csv for a file without a header row (raw logs): the columns are named by their 1-based
+/// position "1", "2", …, as many as the first data line has fields. Throws as read_csv, and
+/// dynid::Error when the first line is not numbers (the file has a header: name its columns).
+CsvTable read_csv_without_header(const std::string& path);
+
 }  // namespace dynid
