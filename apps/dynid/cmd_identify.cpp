@@ -1,4 +1,8 @@
 // `dynid identify` and `dynid validate --mode torque`: parse, validate, call the library, write.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -30,7 +34,67 @@ struct IdentifyCliOptions {
   int threads = 0;
   double torque_offset = 0.0;
   bool filter_coulomb = false;
+  std::vector<double> torque_scale;
+  std::string rows, time;
 };
+
+// The run named by `flag` must be a readable file (so the error names the flag the user gave).
+void require_readable(const std::string& path, const char* flag) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    throw Error(std::string(flag) + " '" + path + "' is a folder; give the file");
+  }
+  if (!std::ifstream(path)) {
+    throw Error(std::string(flag) + " '" + path +
+                "' cannot be opened (missing or unreadable); check the path");
+  }
+}
+
+// The folder of an output named by `flag` must exist, so that a bad path fails before any work
+// and before any other output is written.
+void require_output_folder(const std::string& path, const char* flag) {
+  namespace fs = std::filesystem;
+  if (path.empty()) return;
+  const fs::path parent = fs::path(path).parent_path();
+  std::error_code ec;
+  if (!parent.empty() && !fs::is_directory(parent, ec)) {
+    throw Error(std::string(flag) + " '" + path + "': folder '" + parent.string() +
+                "' does not exist; create it or write elsewhere");
+  }
+}
+
+// How to read the run: --columns, --rate, --torque-scale, --rows / --time.
+RunFileOptions run_file_options(const std::string& columns, double rate,
+                                const std::vector<double>& torque_scale, const std::string& rows,
+                                const std::string& time) {
+  if (!rows.empty() && !time.empty()) {
+    throw UsageError("give --rows or --time, not both: they both choose the window of the run");
+  }
+  if (!(rate >= 0.0) || !std::isfinite(rate)) {
+    throw UsageError("--rate must be a positive sample rate in Hz");
+  }
+  RunFileOptions file;
+  file.columns = parse_column_mapping(columns);
+  file.rate_hz = rate;
+  file.torque_scale = torque_scale;
+  if (!rows.empty()) file.window = parse_run_window(rows, false, "--rows");
+  if (!time.empty()) file.window = parse_run_window(time, true, "--time");
+  return file;
+}
+
+// One line per processing choice on stderr (the result JSON keeps them under `choices`).
+void echo_choices(const char* command, const RunFileReport& read,
+                  const std::vector<std::pair<std::string, std::string>>& choices) {
+  for (const auto& w : read.warnings) std::cerr << "warning: " << w << '\n';
+  for (const auto& note : read.notes) std::cerr << command << ": " << note << '\n';
+  for (const auto& [key, value] : choices)
+    std::cerr << command << ": " << key << ": " << value << '\n';
+}
+
+void warn(const std::string& text) {
+  std::cerr << "warning: " << text << '\n';
+}
 
 std::vector<std::string> split(const std::string& text, char sep) {
   std::vector<std::string> out;
@@ -126,22 +190,42 @@ nlohmann::json echo(const IdentifyCliOptions& o) {
           {"savitzky_golay", o.savgol},
           {"torque_offset_s", o.torque_offset},
           {"filter_coulomb_columns", o.filter_coulomb},
-          {"columns", o.columns}};
+          {"columns", o.columns},
+          {"torque_scale", o.torque_scale},
+          {"rows", o.rows},
+          {"time", o.time}};
+}
+
+// The flags that say how to read a run (identify, validate).
+void add_run_flags(CLI::App* cmd, double& rate, std::string& columns,
+                   std::vector<double>& torque_scale, std::string& rows, std::string& time) {
+  cmd->add_option("--rate", rate, "Sample rate [Hz] when the file has no t column");
+  cmd->add_option("--columns", columns,
+                  "Rename columns before lookup: from=to,from2=to2; for a file without a header, "
+                  "name columns by position counted from 1: 1=t,2=q1,3=q2,...");
+  cmd->add_option("--torque-scale", torque_scale,
+                  "tau_j = K_j * logged torque column (e.g. drive gain x current): one value or "
+                  "one per joint, comma separated")
+      ->delimiter(',');
+  cmd->add_option("--rows", rows,
+                  "Use data rows A:B only (counted from 1 after the header, inclusive; A: or :B "
+                  "leave an end open)");
+  cmd->add_option("--time", time, "Use the samples with T0 <= t <= T1 [s] only (T0: or :T1 open)");
 }
 
 void add_signal_flags(CLI::App* cmd, IdentifyCliOptions& o) {
   cmd->add_option(
          "--filter", o.filter,
          "Zero-phase low-pass on q and tau: auto (Butterworth 4), none, butterworth[:ORDER], "
-         "chebyshev[:ORDER[:RIPPLE_DB]] (default order 8, seed 2)")
+         "chebyshev[:ORDER[:RIPPLE_DB]] (default order 8, as in B. Bona, A. Curatella, "
+         "Closed-loop rigid model identification of an industrial robot, 2005)")
       ->capture_default_str();
   cmd->add_option("--cutoff", o.cutoff, "Filter cut-off [Hz]; 0 = min(20 Hz, rate/10)");
   cmd->add_option("--decimate", o.decimate,
                   "Keep every N-th sample after filtering; 0 = rate/(10·cut-off)");
   cmd->add_option("--trim", o.trim,
                   "Samples dropped at each end after filtering; -1 = 3·rate/cut-off");
-  cmd->add_option("--rate", o.rate, "Sample rate [Hz] when the file has no t column");
-  cmd->add_option("--columns", o.columns, "Rename columns before lookup: from=to,from2=to2");
+  add_run_flags(cmd, o.rate, o.columns, o.torque_scale, o.rows, o.time);
   cmd->add_flag("--savgol", o.savgol,
                 "Differentiate with Savitzky-Golay instead of central differences");
   cmd->add_option("--friction", o.friction,
@@ -156,15 +240,33 @@ void add_signal_flags(CLI::App* cmd, IdentifyCliOptions& o) {
                 "when the filter smears the Coulomb step at reversals");
 }
 
-void run_identify(const IdentifyCliOptions& o) {
+// One warning per option that has no effect in the combination given.
+void warn_identify_no_effect(const IdentifyCliOptions& o, const CLI::App& cmd) {
+  const bool given_filter_options = cmd.count("--cutoff") || cmd.count("--filter-coulomb");
+  if (o.filter == "none" && given_filter_options) {
+    warn("--cutoff and --filter-coulomb have no effect with --filter none");
+  }
+  if (!o.stream && cmd.count("--threads")) warn("--threads has no effect without --stream");
+}
+
+void run_identify(const IdentifyCliOptions& o, const CLI::App& cmd) {
   const IdentifyOptions options = library_options(o);
+  const RunFileOptions file = run_file_options(o.columns, o.rate, o.torque_scale, o.rows, o.time);
+  require_readable(o.data, "--data");
+  require_output_folder(o.out, "--out");
+  if (o.stream &&
+      (!o.torque_scale.empty() || !file.window.empty() || columns_by_position(file.columns))) {
+    throw UsageError(
+        "--stream reads named columns as they are; --torque-scale, --rows, --time and "
+        "--columns by position need the in-memory mode (drop --stream)");
+  }
+  warn_identify_no_effect(o, cmd);
   const Model model = load_robot(o.robot);
-  RunFileOptions file;
-  file.columns = parse_column_mapping(o.columns);
-  file.rate_hz = o.rate;
+  RunFileReport read;
   const IdentificationResult result =
       o.stream ? identify_stream(model, o.data, file, options, {o.threads, true})
-               : identify(model, read_joint_record(o.data, model, file), options);
+               : identify(model, read_joint_record(o.data, model, file, &read), options);
+  echo_choices("identify", read, result.choices);
   std::cout << identification_table(model, result);
   write_json(o.out, identification_to_json(model, result, echo(o)));
   std::cout << "wrote " << o.out << '\n';
@@ -172,11 +274,14 @@ void run_identify(const IdentifyCliOptions& o) {
 
 struct ValidateCliOptions {
   std::string robot, params, data, json, columns, mode = "torque", trajectory, engine = "mujoco";
+  std::string predicted;
   double rate = 0.0;
   std::vector<double> zero_velocity;
+  std::vector<double> torque_scale;
+  std::string rows, time;
 };
 
-void run_validate(const ValidateCliOptions& v) {
+void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
   if (v.mode != "torque" && v.mode != "simulation") {
     throw UsageError("--mode must be torque or simulation, not '" + v.mode + "'");
   }
@@ -187,11 +292,30 @@ void run_validate(const ValidateCliOptions& v) {
   if (v.engine != "mujoco" && v.engine != "native") {
     throw UsageError("--engine must be mujoco or native, not '" + v.engine + "'");
   }
+  RunFileOptions file = run_file_options(v.columns, v.rate, v.torque_scale, v.rows, v.time);
+  require_readable(v.params, "--params");
+  require_readable(v.data, "--data");
+  require_output_folder(v.json, "--json");
+  require_output_folder(v.predicted, "--predicted");
+  if (v.mode == "simulation") {
+    require_readable(v.trajectory, "--trajectory");
+    if (!v.predicted.empty()) warn("--predicted has no effect with --mode simulation");
+    if (cmd.count("--zero-velocity")) warn("--zero-velocity has no effect with --mode simulation");
+  } else {
+    if (!v.trajectory.empty()) warn("--trajectory has no effect with --mode torque");
+    if (cmd.count("--engine")) warn("--engine has no effect with --mode torque");
+  }
   const Model model = load_robot(v.robot);
-  std::vector<std::string> names;
-  Eigen::VectorXd values;
-  nlohmann::json used;
-  read_identified_parameters(v.params, names, values, used);
+  const IdentifiedResultFile identified = read_identification_result(v.params);
+  if (!identified.robot.empty() && identified.robot != model.name) {
+    throw Error("'" + v.params + "' was identified on robot '" + identified.robot +
+                "' but --robot gives '" + model.name +
+                "'; validate with the robot the parameters were identified on");
+  }
+  const std::vector<std::string>& names = identified.names;
+  const Eigen::VectorXd& values = identified.values;
+  const nlohmann::json& used = identified.options;
+  RunFileReport read;
   // The same friction set and signal processing as the identification that wrote the file.
   IdentifyCliOptions o;
   o.friction = used.value("friction", o.friction);
@@ -201,17 +325,34 @@ void run_validate(const ValidateCliOptions& v) {
   o.savgol = used.value("savitzky_golay", false);
   o.torque_offset = used.value("torque_offset_s", 0.0);
   o.filter_coulomb = used.value("filter_coulomb_columns", false);
-  o.zero_velocity = v.zero_velocity.empty() ? used.value("zero_velocity", std::vector<double>{})
-                                            : v.zero_velocity;
+  // The rows left out are those below the thresholds identify used (stored in the result), not
+  // thresholds recomputed from this run.
+  if (!v.zero_velocity.empty()) {
+    o.zero_velocity = v.zero_velocity;
+  } else if (static_cast<int>(identified.zero_velocity_threshold.size()) == model.dof()) {
+    o.zero_velocity = identified.zero_velocity_threshold;
+    if (*std::max_element(o.zero_velocity.begin(), o.zero_velocity.end()) > 0.0) {
+      read.notes.push_back("zero-velocity thresholds as identify used them (stored in '" +
+                           v.params + "')");
+    }
+  } else {
+    o.zero_velocity = used.value("zero_velocity", std::vector<double>{});
+  }
+  if (v.torque_scale.empty() && !cmd.count("--torque-scale")) {
+    file.torque_scale = used.value("torque_scale", std::vector<double>{});
+    if (!file.torque_scale.empty()) {
+      read.notes.push_back("--torque-scale as given to identify (stored in '" + v.params + "')");
+    }
+  }
   const IdentifyOptions options = library_options(o);
-  RunFileOptions file;
-  file.columns = parse_column_mapping(v.columns);
-  file.rate_hz = v.rate;
-  const JointRecord record = read_joint_record(v.data, model, file);
+  const JointRecord record = read_joint_record(v.data, model, file, &read);
   if (v.mode == "simulation") {
-    const JointRecord ref = read_reference(v.trajectory, model, file);
+    RunFileOptions reference_file;
+    if (!columns_by_position(file.columns)) reference_file.columns = file.columns;
+    const JointRecord ref = read_reference(v.trajectory, model, reference_file);
     PlantOptions plant;
     plant.engine = v.engine == "mujoco" ? PlantEngine::kMujoco : PlantEngine::kNative;
+    echo_choices("validate", read, {});
     const SimulationValidation sv =
         validate_run_by_simulation(identified_model(model, names, values, options), ref.t, ref.q,
                                    ref.dq, ref.ddq, record.q, record.tau, plant);
@@ -223,10 +364,15 @@ void run_validate(const ValidateCliOptions& v) {
     return;
   }
   const ValidationResult result = validate_torques(model, record, names, values, options);
+  echo_choices("validate", read, result.choices);
   std::cout << validation_table(model, result);
   if (!v.json.empty()) {
     write_json(v.json, validation_to_json(model, result));
     std::cout << "wrote " << v.json << '\n';
+  }
+  if (!v.predicted.empty()) {
+    write_validation_predictions(v.predicted, result);
+    std::cout << "wrote " << v.predicted << '\n';
   }
 }
 
@@ -258,7 +404,7 @@ void add_identify_command(CLI::App& app) {
                   "on it beyond round-off")
       ->capture_default_str();
   add_signal_flags(cmd, *o);
-  cmd->callback([o] { run_identify(*o); });
+  cmd->callback([o, cmd] { run_identify(*o, *cmd); });
 }
 
 void add_validate_command(CLI::App& app) {
@@ -272,19 +418,23 @@ void add_validate_command(CLI::App& app) {
   cmd->add_option("--json", v->json, "Write the per-joint errors as JSON");
   cmd->add_option("--mode", v->mode,
                   "torque (predict the measured torques) or simulation (simulate the identified "
-                  "model under the same reference and controller, seed 2 §3.5)")
+                  "model under the same reference and controller, as in B. Bona, A. Curatella, "
+                  "Closed-loop rigid model identification of an industrial robot, 2005)")
       ->capture_default_str();
   cmd->add_option("--trajectory", v->trajectory,
                   "With --mode simulation: the reference CSV of the run");
   cmd->add_option("--engine", v->engine, "With --mode simulation: mujoco or native")
       ->capture_default_str();
-  cmd->add_option("--rate", v->rate, "Sample rate [Hz] when the file has no t column");
-  cmd->add_option("--columns", v->columns, "Rename columns before lookup: from=to,from2=to2");
+  cmd->add_option("--predicted", v->predicted,
+                  "Write t and, per joint, measured torque, predicted torque, residual and a "
+                  "left-out flag as CSV (tau<j>, tau_pred<j>, residual<j>, left_out<j>)");
+  add_run_flags(cmd, v->rate, v->columns, v->torque_scale, v->rows, v->time);
   cmd->add_option("--zero-velocity", v->zero_velocity,
-                  "Leave rows of joint j with |dq_j| below this [rad/s] out of the torque "
-                  "statistics (1 or n values); default: as the identification did; 0 keeps all")
+                  "Rows of joint j with |dq_j| below this [rad/s] are left out of the second "
+                  "(near-still-free) error figure (1 or n values); default: the thresholds "
+                  "identify used; 0 keeps all")
       ->delimiter(',');
-  cmd->callback([v] { run_validate(*v); });
+  cmd->callback([v, cmd] { run_validate(*v, *cmd); });
 }
 
 }  // namespace dynid::cli

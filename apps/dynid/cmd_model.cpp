@@ -27,7 +27,10 @@ ParameterLayout parse_layout(const std::string& text) {
       "--friction for --base must be none (link parameters only) or full (with Ia, Fv, Fc, Fo)");
 }
 
-void run_model(const ModelOptions& options) {
+void run_model(const ModelOptions& options, const CLI::App& cmd) {
+  if (!options.base && cmd.count("--friction")) {
+    std::cerr << "warning: --friction has no effect without --base\n";
+  }
   const Model model = load_robot(options.robot);
   std::cout << model_summary_text(model);
   nlohmann::json json = model_to_json(model);
@@ -73,7 +76,7 @@ void add_model_command(CLI::App& app) {
   cmd->add_option("--friction", options->friction,
                   "With --base: none (link parameters only) or full (also Ia, Fv, Fc, Fo)")
       ->capture_default_str();
-  cmd->callback([options] { run_model(*options); });
+  cmd->callback([options, cmd] { run_model(*options, *cmd); });
 }
 
 }  // namespace dynid::cli

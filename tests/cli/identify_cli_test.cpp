@@ -115,7 +115,8 @@ TEST(IdentifyCli, ValidateUsesTheIdentificationZeroVelocityThreshold) {
   const std::string val = ::testing::TempDir() + "/planar2_coulomb_val.json";
   CliRun r = run("validate --robot planar2 --params " + out + " --data " + data + " --json " + val);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("left out, as in identify"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("left out, as identify left them out of the fit"), std::string::npos)
+      << r.out;
   auto v = load(val);
   const long samples = v["samples"].get<long>();
   EXPECT_GT(v["rows_excluded_zero_velocity"].get<long>(), 0);
