@@ -417,6 +417,23 @@ TEST_F(RealLogsCli, NoIdentityExpressionsAndAlignedTables) {
   EXPECT_EQ(ends[0], ends[1]) << v.out;
 }
 
+// Item 4: the demo prints the validation error over every row first, the near-still-free one
+// second, and validates with the thresholds its identification used.
+TEST_F(RealLogsCli, DemoLeadsWithTheErrorOverEveryRow) {
+  const CliRun demo = run("demo --robot planar2 --native --periods 4 --out " + path("demo"));
+  ASSERT_EQ(demo.code, 0) << demo.err;
+  const auto every = demo.out.find("relative torque error over every row");
+  const auto still = demo.out.find("without the");
+  ASSERT_NE(every, std::string::npos) << demo.out;
+  ASSERT_NE(still, std::string::npos) << demo.out;
+  EXPECT_LT(every, still) << demo.out;
+  const auto result = load(path("demo/result.json"));
+  const auto validation = load(path("demo/validation.json"));
+  EXPECT_TRUE(validation.contains("relative_error_all_rows"));
+  EXPECT_EQ(validation["rows_left_out"]["zero_velocity_threshold"],
+            result["zero_velocity_threshold"]);
+}
+
 // Item 8: the excitation JSON reports one condition number and says what it is.
 TEST_F(RealLogsCli, ExcitationReportsOneDefinedConditionNumber) {
   const CliRun ex =
