@@ -429,6 +429,10 @@ void add_validate_command(CLI::App& app) {
                   "Write t and, per joint, measured torque, predicted torque, residual and a "
                   "left-out flag as CSV (tau<j>, tau_pred<j>, residual<j>, left_out<j>)");
   add_run_flags(cmd, v->rate, v->columns, v->torque_scale, v->rows, v->time);
+  cmd->get_option("--torque-scale")
+      ->description(
+          "tau_j = K_j * logged torque column (e.g. drive gain x current): one value or one per "
+          "joint, comma separated; default: the scale given to identify (stored in --params)");
   cmd->add_option("--zero-velocity", v->zero_velocity,
                   "Rows of joint j with |dq_j| below this [rad/s] are left out of the second "
                   "(near-still-free) error figure (1 or n values); default: the thresholds "

@@ -286,6 +286,8 @@ TEST_F(RealLogsCli, TorqueScaleTurnsLoggedColumnsIntoTorques) {
   expect_error(run(base + " --torque-scale nan"), 2, {"--torque-scale"});
   expect_error(run(base + " --torque-scale 0"), 2, {"--torque-scale"});
   expect_error(run(base + " --torque-scale 1,2,3"), 2, {"--torque-scale", "1 or 2"});
+  expect_error(run(base + " --stream --filter none --torque-scale 2"), 2,
+               {"--stream", "--torque-scale"});
   EXPECT_FALSE(fs::exists(path("x.json")));
 }
 
