@@ -3,7 +3,6 @@
 // tau += Ia ddq + Fv dq + Fc sign(dq) + Fo with the values the model JSON reports, and the robot
 // table of docs/methods/model.md for the joint counts.
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -18,24 +17,14 @@
 
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/version.hpp"
+#include "support/cli_run.hpp"
 
 namespace dynid {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct RunResult {
-  int code = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using RunResult = testing::CliResult;
 
 class Cli : public ::testing::Test {
  protected:
@@ -49,18 +38,7 @@ class Cli : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
 
   /// Runs `dynid <args>` (args are shell words; paths here contain no spaces).
-  RunResult run(const std::string& args) const {
-    const fs::path out = dir_ / "stdout.txt";
-    const fs::path err = dir_ / "stderr.txt";
-    const std::string command = std::string("'") + DYNID_BINARY + "' " + args + " >'" +
-                                out.string() + "' 2>'" + err.string() + "' </dev/null";
-    const int status = std::system(command.c_str());
-    RunResult r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-  }
+  RunResult run(const std::string& args) const { return testing::run_dynid(args, dir_); }
   std::string work(const std::string& name) const { return (dir_ / "work" / name).string(); }
   std::string write(const std::string& name, const std::string& text) const {
     std::ofstream(work(name), std::ios::binary) << text;

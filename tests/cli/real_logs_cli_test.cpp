@@ -4,13 +4,11 @@
 // echo of every processing choice) and the messages a new user meets.
 // Oracle: a planar2 run generated here from the closed form of docs/methods/model.md (not by
 // dynid), so the predicted torques and the identified ZZ1R are known without the code under test.
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -21,22 +19,13 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "support/cli_run.hpp"
+#include "support/planar2.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
-
-struct CliRun {
-  int code;
-  std::string out;
-  std::string err;
-};
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using CliRun = dynid::testing::CliResult;
 
 std::vector<std::string> lines_of(const std::string& text) {
   std::vector<std::string> out;
@@ -46,14 +35,30 @@ std::vector<std::string> lines_of(const std::string& text) {
   return out;
 }
 
-// Closed-form planar2 (l1 = 1, m1 = 2, m2 = 1.5, c1 = 0.5, c2 = 0.4, slender rods, g along -y).
+// The numbers of each data line of a CSV with a header (read here, not by dynid).
+std::vector<std::vector<double>> csv_rows(const std::string& path, std::string& header) {
+  std::ifstream csv(path);
+  std::getline(csv, header);
+  std::vector<std::vector<double>> rows;
+  std::string line, field;
+  while (std::getline(csv, line)) {
+    std::stringstream s(line);
+    rows.emplace_back();
+    while (std::getline(s, field, ',')) rows.back().push_back(std::stod(field));
+  }
+  return rows;
+}
+
+// Closed-form planar2 of examples/robots/planar2.yaml (slender rods: I = m·l²/12 about the centre
+// of mass) on a fixed trajectory.
 struct Sample {
   double t, q[2], dq[2], ddq[2], tau[2];
 };
 
 Sample planar2_sample(int k, double dt) {
-  const double m1 = 2.0, m2 = 1.5, l1 = 1.0, c1 = 0.5, c2 = 0.4, I1 = 2.0 / 12,
-               I2 = 1.5 * 0.64 / 12, g = 9.81;
+  dynid::testing::Planar2 arm;
+  arm.I1 = 2.0 / 12;
+  arm.I2 = 1.5 * 0.64 / 12;
   Sample s{};
   const double t = k * dt;
   s.t = t;
@@ -63,15 +68,10 @@ Sample planar2_sample(int k, double dt) {
   s.dq[1] = -1.04 * std::sin(1.3 * t);
   s.ddq[0] = -0.49 * std::sin(0.7 * t) - 1.323 * std::sin(2.1 * t);
   s.ddq[1] = -1.352 * std::cos(1.3 * t);
-  const double q2 = s.q[1], q1 = s.q[0];
-  const double d11 = m1 * c1 * c1 + m2 * (l1 * l1 + c2 * c2 + 2 * l1 * c2 * std::cos(q2)) + I1 + I2;
-  const double d12 = m2 * (c2 * c2 + l1 * c2 * std::cos(q2)) + I2, d22 = m2 * c2 * c2 + I2;
-  const double h = -m2 * l1 * c2 * std::sin(q2);
-  const double g1 = (m1 * c1 + m2 * l1) * g * std::cos(q1) + m2 * c2 * g * std::cos(q1 + q2);
-  const double g2 = m2 * c2 * g * std::cos(q1 + q2);
-  s.tau[0] =
-      d11 * s.ddq[0] + d12 * s.ddq[1] + h * s.dq[1] * s.dq[1] + 2 * h * s.dq[0] * s.dq[1] + g1;
-  s.tau[1] = d12 * s.ddq[0] + d22 * s.ddq[1] - h * s.dq[0] * s.dq[0] + g2;
+  const Eigen::Vector2d tau =
+      arm.torque({s.q[0], s.q[1]}, {s.dq[0], s.dq[1]}, {s.ddq[0], s.ddq[1]});
+  s.tau[0] = tau[0];
+  s.tau[1] = tau[1];
   return s;
 }
 
@@ -91,13 +91,7 @@ class RealLogsCli : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  CliRun run(const std::string& args) const {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = std::string("'") + DYNID_BINARY + "' " + args + " >'" + out.string() +
-                            "' 2>'" + err.string() + "' </dev/null";
-    const int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
-  }
+  CliRun run(const std::string& args) const { return dynid::testing::run_dynid(args, dir_); }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
 
   // The run with a header t,q1,q2,dq1,dq2,ddq1,ddq2,tau1,tau2; torque columns divided by `scale`.
@@ -127,6 +121,14 @@ class RealLogsCli : public ::testing::Test {
       << ", link: forearm, sigma: 0, alpha: 0, d: 1.0, theta: 0, r: 0,\n"
          "     mass: 1.5, com: [0.4, 0, 0], inertia_com: [0, 0, 0, 0.08, 0, 0.08]}\n";
     return path(name);
+  }
+  // Identifies the link parameters only (no filter, no friction) from `data`; the result's path.
+  std::string identify_rigid(const std::string& data) const {
+    const CliRun r =
+        run("identify --robot planar2 --data " + data +
+            " --filter none --friction none --no-armature --out " + path("result.json"));
+    EXPECT_EQ(r.code, 0) << r.err;
+    return path("result.json");
   }
   static nlohmann::json load(const std::string& p) {
     return nlohmann::json::parse(std::ifstream(p));
@@ -183,18 +185,11 @@ TEST_F(RealLogsCli, ValidateReportsEveryRowFirstWithTheStoredThresholds) {
   EXPECT_EQ(j["rows_left_out"]["zero_velocity_threshold"][1].get<double>(), thr[1]);
   EXPECT_TRUE(j["rows_left_out"].contains("rule"));
   // Rows left out, counted from the closed-form velocity at the predicted CSV's time stamps.
-  std::ifstream csv(pred);
-  std::string header, line;
-  std::getline(csv, header);
+  std::string header;
   long expected[2] = {0, 0}, flagged[2] = {0, 0}, rows = 0;
-  while (std::getline(csv, line)) {
-    std::vector<double> x;
-    std::stringstream s(line);
-    std::string field;
-    while (std::getline(s, field, ',')) x.push_back(std::stod(field));
+  for (const auto& x : csv_rows(pred, header)) {
     ASSERT_EQ(x.size(), 9u);
-    const int k = static_cast<int>(std::lround(x[0] / kDt));
-    const Sample truth = planar2_sample(k, kDt);
+    const Sample truth = planar2_sample(static_cast<int>(std::lround(x[0] / kDt)), kDt);
     for (int i = 0; i < 2; ++i) {
       expected[i] += std::abs(truth.dq[i]) < thr[i];
       flagged[i] += x[4 + 4 * i] == 1.0;
@@ -214,25 +209,17 @@ TEST_F(RealLogsCli, ValidateReportsEveryRowFirstWithTheStoredThresholds) {
 // the closed-form torque (no filtering) and a noise-free run is predicted to round-off.
 TEST_F(RealLogsCli, ValidatePredictedWritesMeasuredPredictedAndResidual) {
   const std::string data = write_run("run.csv");
-  const std::string result = path("result.json");
-  ASSERT_EQ(run("identify --robot planar2 --data " + data +
-                " --filter none --friction none --no-armature --out " + result)
-                .code,
-            0);
+  const std::string result = identify_rigid(data);
+  ASSERT_TRUE(fs::exists(result));
   const std::string pred = path("pred.csv");
   const CliRun v = run("validate --robot planar2 --params " + result + " --data " + data +
                        " --predicted " + pred);
   ASSERT_EQ(v.code, 0) << v.err;
-  std::ifstream csv(pred);
-  std::string header, line;
-  std::getline(csv, header);
+  std::string header;
+  const auto predicted_rows = csv_rows(pred, header);
   EXPECT_EQ(header, "t,tau1,tau_pred1,residual1,left_out1,tau2,tau_pred2,residual2,left_out2");
   long rows = 0;
-  while (std::getline(csv, line)) {
-    std::vector<double> x;
-    std::stringstream s(line);
-    std::string field;
-    while (std::getline(s, field, ',')) x.push_back(std::stod(field));
+  for (const auto& x : predicted_rows) {
     ASSERT_EQ(x.size(), 9u);
     const Sample truth = planar2_sample(static_cast<int>(std::lround(x[0] / kDt)), kDt);
     for (int i = 0; i < 2; ++i) {
@@ -255,11 +242,8 @@ TEST_F(RealLogsCli, ValidatePredictedWritesMeasuredPredictedAndResidual) {
 // Item 4: a result identified on another robot (same joint count, other name) is refused.
 TEST_F(RealLogsCli, ValidateRefusesAResultOfAnotherRobot) {
   const std::string data = write_run("run.csv");
-  const std::string result = path("result.json");
-  ASSERT_EQ(run("identify --robot planar2 --data " + data +
-                " --filter none --friction none --no-armature --out " + result)
-                .code,
-            0);
+  const std::string result = identify_rigid(data);
+  ASSERT_TRUE(fs::exists(result));
   const std::string other = write_model("twin.yaml", "planar2_twin", "shoulder", "elbow");
   expect_error(run("validate --robot " + other + " --params " + result + " --data " + data), 1,
                {"'planar2'", "'planar2_twin'"});
