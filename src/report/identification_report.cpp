@@ -1,11 +1,13 @@
 #include "dynid/report/identification_report.hpp"
 
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/version.hpp"
 
@@ -109,7 +111,7 @@ void read_identified_parameters(const std::string& path, std::vector<std::string
   try {
     j = nlohmann::json::parse(f);
   } catch (const std::exception& ex) {
-    throw Error("'" + path + "' is not valid JSON (" + std::string(ex.what()) + ")");
+    throw Error("'" + path + "' is not valid JSON (" + one_line(ex.what()) + ")");
   }
   if (!j.contains("parameters") || !j["parameters"].is_array()) {
     throw Error("'" + path + "' has no 'parameters' list; give the result.json of dynid identify");
@@ -118,14 +120,22 @@ void read_identified_parameters(const std::string& path, std::vector<std::string
   values.resize(static_cast<Eigen::Index>(j["parameters"].size()));
   for (size_t i = 0; i < j["parameters"].size(); ++i) {
     const auto& p = j["parameters"][i];
-    if (!p.contains("name") || !p.contains("value") || !p["value"].is_number()) {
+    if (!p.is_object() || !p.contains("name") || !p["name"].is_string() || !p.contains("value") ||
+        !p["value"].is_number()) {
       throw Error("'" + path + "': parameters[" + std::to_string(i) +
-                  "] needs a name and a numeric value");
+                  "] needs a string name and a numeric value");
     }
     names.push_back(p["name"].get<std::string>());
     values[static_cast<Eigen::Index>(i)] = p["value"].get<double>();
+    if (!std::isfinite(values[static_cast<Eigen::Index>(i)])) {
+      throw Error("'" + path + "': parameters[" + std::to_string(i) +
+                  "].value overflows a double; give the result.json of dynid identify");
+    }
   }
   options_used = j.value("options", nlohmann::json::object());
+  if (!options_used.is_object()) {
+    throw Error("'" + path + "': 'options' must be an object (as dynid identify writes it)");
+  }
 }
 
 nlohmann::json base_parameters_to_json(const BaseParameters& base) {
