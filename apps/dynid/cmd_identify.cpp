@@ -1,4 +1,5 @@
 // `dynid identify` and `dynid validate --mode torque`: parse, validate, call the library, write.
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -30,6 +31,7 @@ struct IdentifyCliOptions {
   int threads = 0;
   double torque_offset = 0.0;
   bool filter_coulomb = false;
+  std::string outliers = "report";
 };
 
 std::vector<std::string> split(const std::string& text, char sep) {
@@ -107,6 +109,10 @@ IdentifyOptions library_options(const IdentifyCliOptions& o) {
   out.signal.savitzky_golay = o.savgol;
   out.signal.torque_time_offset = o.torque_offset;
   out.signal.filter_coulomb_columns = o.filter_coulomb;
+  if (o.outliers != "report" && o.outliers != "drop") {
+    throw UsageError("--outliers must be report or drop, not '" + o.outliers + "'");
+  }
+  out.outliers.policy = o.outliers == "drop" ? OutlierPolicy::kDrop : OutlierPolicy::kReport;
   return out;
 }
 
@@ -126,6 +132,7 @@ nlohmann::json echo(const IdentifyCliOptions& o) {
           {"savitzky_golay", o.savgol},
           {"torque_offset_s", o.torque_offset},
           {"filter_coulomb_columns", o.filter_coulomb},
+          {"outliers", o.outliers},
           {"columns", o.columns}};
 }
 
@@ -170,6 +177,23 @@ void run_identify(const IdentifyCliOptions& o) {
   std::cout << "wrote " << o.out << '\n';
 }
 
+// The options a result JSON records, read with the file and key named in any error (a wrong type
+// is the file's fault, not a command-line flag's).
+struct FileOptions {
+  const nlohmann::json& used;
+  const std::string& path;
+  template <typename T>
+  T get(const char* key, const T& fallback) const {
+    if (!used.contains(key)) return fallback;
+    try {
+      return used.at(key).get<T>();
+    } catch (const nlohmann::json::exception&) {
+      throw Error("'" + path + "': options." + key + " has the wrong type (" +
+                  used.at(key).type_name() + "); give the result.json of dynid identify unedited");
+    }
+  }
+};
+
 struct ValidateCliOptions {
   std::string robot, params, data, json, columns, mode = "torque", trajectory, engine = "mujoco";
   double rate = 0.0;
@@ -194,16 +218,24 @@ void run_validate(const ValidateCliOptions& v) {
   read_identified_parameters(v.params, names, values, used);
   // The same friction set and signal processing as the identification that wrote the file.
   IdentifyCliOptions o;
-  o.friction = used.value("friction", o.friction);
-  o.no_armature = !used.value("armature", true);
-  o.filter = used.value("filter", o.filter);
-  o.cutoff = used.value("cutoff_hz", 0.0);
-  o.savgol = used.value("savitzky_golay", false);
-  o.torque_offset = used.value("torque_offset_s", 0.0);
-  o.filter_coulomb = used.value("filter_coulomb_columns", false);
-  o.zero_velocity = v.zero_velocity.empty() ? used.value("zero_velocity", std::vector<double>{})
-                                            : v.zero_velocity;
-  const IdentifyOptions options = library_options(o);
+  const FileOptions file_options{used, v.params};
+  o.friction = file_options.get("friction", o.friction);
+  o.no_armature = !file_options.get("armature", true);
+  o.filter = file_options.get("filter", o.filter);
+  o.cutoff = file_options.get("cutoff_hz", 0.0);
+  o.savgol = file_options.get("savitzky_golay", false);
+  o.torque_offset = file_options.get("torque_offset_s", 0.0);
+  o.filter_coulomb = file_options.get("filter_coulomb_columns", false);
+  o.zero_velocity = v.zero_velocity.empty()
+                        ? file_options.get("zero_velocity", std::vector<double>{})
+                        : v.zero_velocity;
+  IdentifyOptions options;
+  try {
+    options = library_options(o);
+  } catch (const UsageError& e) {  // the values come from the file, not from the command line
+    throw Error("'" + v.params + "': a value under 'options' is not valid (" + e.what() +
+                "); give the result.json of dynid identify unedited");
+  }
   RunFileOptions file;
   file.columns = parse_column_mapping(v.columns);
   file.rate_hz = v.rate;
@@ -223,6 +255,14 @@ void run_validate(const ValidateCliOptions& v) {
     return;
   }
   const ValidationResult result = validate_torques(model, record, names, values, options);
+  if (!result.rms.allFinite() || !result.relative_error.allFinite() ||
+      !std::isfinite(result.relative_error_all) || !std::isfinite(result.relative_error_all_rows)) {
+    std::ostringstream largest;
+    largest << (values.size() ? values.cwiseAbs().maxCoeff() : 0.0);
+    throw Error("the predicted torques overflow: the parameter values in '" + v.params +
+                "' (largest |value| " + largest.str() + ") or the torques in '" + v.data +
+                "' are implausibly large; check both files and their units");
+  }
   std::cout << validation_table(model, result);
   if (!v.json.empty()) {
     write_json(v.json, validation_to_json(model, result));
@@ -258,6 +298,10 @@ void add_identify_command(CLI::App& app) {
                   "on it beyond round-off")
       ->capture_default_str();
   add_signal_flags(cmd, *o);
+  cmd->add_option("--outliers", o->outliers,
+                  "Gross torque outliers (Hampel test): report (warn, keep them) or drop (replace "
+                  "each by its neighbours' median)")
+      ->capture_default_str();
   cmd->callback([o] { run_identify(*o); });
 }
 
