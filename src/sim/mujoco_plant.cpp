@@ -160,13 +160,14 @@ class MujocoPlant final : public Plant {
   void step(const Eigen::Ref<const Eigen::VectorXd>& tau) override {
     apply(tau);
     const int bad = d_->warning[mjWARN_BADQACC].number;
+    const double start = d_->time;  // MuJoCo resets the time with the state when it diverges
     mj_step(m_.get(), d_.get());
     for (int j = 0; j < n_; ++j) {
       q_[j] = d_->qpos[qpos_[j]];
       dq_[j] = d_->qvel[dof_[j]];
     }
     if (d_->warning[mjWARN_BADQACC].number != bad || !q_.allFinite() || !dq_.allFinite())
-      throw Error("mujoco plant: the simulation diverged at t = " + std::to_string(d_->time) +
+      throw Error("mujoco plant: the simulation diverged at t = " + std::to_string(start + dt_) +
                   " s (MuJoCo: " + one_line(last_mujoco_warning) +
                   "); check the reference and the model, lower the torque or the sample time dt");
   }
