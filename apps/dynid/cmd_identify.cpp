@@ -194,6 +194,27 @@ struct FileOptions {
   }
 };
 
+// A usage error raised by an option value read from a result file: the file and its key are at
+// fault, not the command-line flag the message names (exit 1, not 2).
+Error file_option_error(const UsageError& e, const std::string& path) {
+  static const std::pair<const char*, const char*> kKeys[] = {
+      {"--friction", "friction"},
+      {"--filter", "filter"},
+      {"--cutoff", "cutoff_hz"},
+      {"--torque-offset", "torque_offset_s"},
+      {"--zero-velocity", "zero_velocity"}};
+  std::string text = e.what();
+  for (const auto& [flag, key] : kKeys) {
+    if (text.rfind(flag, 0) == 0) {
+      text = "options." + std::string(key) + text.substr(std::string(flag).size());
+      break;
+    }
+  }
+  return Error("'" + path + "': " + text +
+               " (in the file; give the result.json of dynid identify "
+               "unedited)");
+}
+
 struct ValidateCliOptions {
   std::string robot, params, data, json, columns, mode = "torque", trajectory, engine = "mujoco";
   double rate = 0.0;
@@ -232,9 +253,8 @@ void run_validate(const ValidateCliOptions& v) {
   IdentifyOptions options;
   try {
     options = library_options(o);
-  } catch (const UsageError& e) {  // the values come from the file, not from the command line
-    throw Error("'" + v.params + "': a value under 'options' is not valid (" + e.what() +
-                "); give the result.json of dynid identify unedited");
+  } catch (const UsageError& e) {
+    throw file_option_error(e, v.params);
   }
   RunFileOptions file;
   file.columns = parse_column_mapping(v.columns);
@@ -254,7 +274,13 @@ void run_validate(const ValidateCliOptions& v) {
     }
     return;
   }
-  const ValidationResult result = validate_torques(model, record, names, values, options);
+  ValidationResult result;
+  try {
+    result = validate_torques(model, record, names, values, options);
+  } catch (const UsageError& e) {  // --zero-velocity is the user's own when given
+    if (!v.zero_velocity.empty()) throw;
+    throw file_option_error(e, v.params);
+  }
   if (!result.rms.allFinite() || !result.relative_error.allFinite() ||
       !std::isfinite(result.relative_error_all) || !std::isfinite(result.relative_error_all_rows)) {
     std::ostringstream largest;

@@ -139,7 +139,12 @@ TEST_F(Contract, ResultFileWithWrongTypesOrValuesIsBlamedOnTheFile) {
   j["options"]["friction"] = "magic";
   write("valued.json", j.dump());
   expect_error(run("validate --robot planar2 --params " + work("valued.json") + " --data " + data),
-               1, "valued.json': a value under 'options' is not valid");
+               1, "valued.json': options.friction: unknown term 'magic'");
+  j["options"]["friction"] = "viscous,coulomb,offset";
+  j["options"]["zero_velocity"] = {0.1, 0.2, 0.3};  // three values for two joints
+  write("counted.json", j.dump());
+  expect_error(run("validate --robot planar2 --params " + work("counted.json") + " --data " + data),
+               1, "counted.json': options.zero_velocity takes 1 or 2 values, got 3");
   j["options"] = "none";
   write("options.json", j.dump());
   expect_error(run("validate --robot planar2 --params " + work("options.json") + " --data " + data),
