@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/io/joint_record_file.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/io/streaming_identification.hpp"
@@ -283,10 +284,10 @@ void run_validate(const ValidateCliOptions& v) {
   }
   if (!result.rms.allFinite() || !result.relative_error.allFinite() ||
       !std::isfinite(result.relative_error_all) || !std::isfinite(result.relative_error_all_rows)) {
-    std::ostringstream largest;
-    largest << (values.size() ? values.cwiseAbs().maxCoeff() : 0.0);
     throw Error("the predicted torques overflow: the parameter values in '" + v.params +
-                "' (largest |value| " + largest.str() + ") or the torques in '" + v.data +
+                "' (largest |value| " +
+                short_number(values.size() ? values.cwiseAbs().maxCoeff() : 0.0) +
+                ") or the torques in '" + v.data +
                 "' are implausibly large; check both files and their units");
   }
   std::cout << validation_table(model, result);

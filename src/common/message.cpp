@@ -104,6 +104,12 @@ std::string one_line(std::string_view text) {
   return out.substr(first, out.find_last_not_of(' ') - first + 1);
 }
 
+std::string short_number(double x) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.4g", x);
+  return buffer;
+}
+
 std::string valid_utf8(std::string_view text) {
   std::string out;
   out.reserve(text.size());

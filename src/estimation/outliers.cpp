@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
@@ -23,19 +22,13 @@ double median(std::vector<double>& v) {
   return *mid;
 }
 
-std::string number(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.4g", x);
-  return buffer;
-}
-
 std::string describe(const std::vector<TorqueOutlier>& outliers, const JointRecord& record) {
   std::string s;
   for (std::size_t i = 0; i < outliers.size() && i < kListed; ++i) {
     const TorqueOutlier& o = outliers[i];
     s += (i ? ", " : "") + std::string("tau") + std::to_string(o.joint + 1) + " at sample " +
-         std::to_string(o.sample + 1) + " (t = " + number(record.t[o.sample]) +
-         " s) = " + number(o.value);
+         std::to_string(o.sample + 1) + " (t = " + short_number(record.t[o.sample]) +
+         " s) = " + short_number(o.value);
   }
   if (outliers.size() > kListed) s += " and " + std::to_string(outliers.size() - kListed) + " more";
   return s;
@@ -112,7 +105,7 @@ void check_finite_estimate(const Estimate& estimate, const ScreenedRun& screened
             "); pass --outliers drop or clean the log";
   } else {
     const double largest = screened.record.tau.cwiseAbs().maxCoeff();
-    cause = "the torques reach " + number(largest) +
+    cause = "the torques reach " + short_number(largest) +
             " in magnitude, too large to square in double precision; check their units";
   }
   throw Error("the estimate is not finite: " + cause);

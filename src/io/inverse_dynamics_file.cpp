@@ -1,10 +1,10 @@
 #include "dynid/io/inverse_dynamics_file.hpp"
 
 #include <algorithm>
-#include <cstdio>
 #include <string>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/dynamics/workspace.hpp"
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/io/csv_writer.hpp"
@@ -41,10 +41,8 @@ CsvTable inverse_dynamics_table(const Model& model, const CsvTable& states,
     rnea(model, ws, qi, dqi, ddqi, tau, rnea_options);
     if (!tau.allFinite()) {
       // Finite but huge states (dq = 1e155: dq² overflows) give Inf or NaN torques.
-      char largest[32];
-      std::snprintf(largest, sizeof(largest), "%.3g",
-                    std::max({qi.cwiseAbs().maxCoeff(), dqi.cwiseAbs().maxCoeff(),
-                              ddqi.cwiseAbs().maxCoeff()}));
+      const std::string largest = short_number(std::max(
+          {qi.cwiseAbs().maxCoeff(), dqi.cwiseAbs().maxCoeff(), ddqi.cwiseAbs().maxCoeff()}));
       throw Error(states.source + " line " + std::to_string(states.line_of(i)) +
                   ": the torques overflow for these q, dq, ddq (largest |value| " + largest +
                   "); check the row and the units (rad, rad/s, rad/s²)");

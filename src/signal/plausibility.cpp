@@ -1,17 +1,10 @@
 #include "dynid/signal/plausibility.hpp"
 
-#include <cstdio>
-
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 
 namespace dynid {
 namespace {
-
-std::string number(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.4g", x);
-  return buffer;
-}
 
 std::string join(const std::vector<std::string>& items) {
   std::string out;
@@ -31,13 +24,14 @@ std::vector<std::string> check_run_plausibility(const Eigen::Ref<const Eigen::Ve
   if (m >= 2 && t[m - 1] > t[0]) {
     const double rate = static_cast<double>(m - 1) / (t[m - 1] - t[0]);
     if (rate < options.min_rate_hz || rate > options.max_rate_hz) {
-      throw Error("the time stamps give a sample rate of " + number(rate) + " Hz, outside " +
-                  number(options.min_rate_hz) + " Hz to " + number(options.max_rate_hz) +
+      throw Error("the time stamps give a sample rate of " + short_number(rate) + " Hz, outside " +
+                  short_number(options.min_rate_hz) + " Hz to " +
+                  short_number(options.max_rate_hz) +
                   " Hz: t must be in seconds (divide milliseconds by 1000, microseconds by 1e6) "
                   "or --rate must be in Hz");
     }
     if (rate < options.low_rate_hz) {
-      warnings.push_back("low sample rate " + number(rate) +
+      warnings.push_back("low sample rate " + short_number(rate) +
                          " Hz: accelerations from so few samples are unreliable; if t is in "
                          "milliseconds, convert it to seconds");
     }
@@ -57,7 +51,7 @@ std::vector<std::string> check_run_plausibility(const Eigen::Ref<const Eigen::Ve
   }
   if (static_cast<Eigen::Index>(still.size()) == q.cols()) {
     throw Error("the run does not move (every joint's position range is below " +
-                number(options.still_range) +
+                short_number(options.still_range) +
                 " rad): record a run on an excitation trajectory (dynid excite, dynid simulate)");
   }
   if (!zero_torque.empty()) {
@@ -66,7 +60,7 @@ std::vector<std::string> check_run_plausibility(const Eigen::Ref<const Eigen::Ve
   }
   if (!still.empty()) {
     warnings.push_back(join(still) + " do not move (position range below " +
-                       number(options.still_range) +
+                       short_number(options.still_range) +
                        " rad): their parameters are not excited by this run");
   }
   return warnings;

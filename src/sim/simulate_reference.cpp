@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <string>
 #include <vector>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/dynamics/mass_matrix.hpp"
 #include "dynid/signal/sampling_check.hpp"
 
@@ -49,12 +49,6 @@ Reference periodic_reference(const Eigen::Ref<const Eigen::VectorXd>& t,
 constexpr double kDivergenceMargin = M_PI;
 constexpr double kBandPercentile = 0.01;
 
-std::string number(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.4g", x);
-  return buffer;
-}
-
 struct Band {
   double lo, hi;  // robust span of the reference
   double margin;  // allowed distance outside [lo, hi]
@@ -79,9 +73,10 @@ void check_reference_rows(const Model& model, const Eigen::Ref<const Eigen::Matr
     for (Eigen::Index k = 0; k < q.rows(); ++k) {
       if (!band.contains(q(k, j))) {
         throw Error("simulate: reference sample " + std::to_string(k + 1) + ": joint " +
-                    model.joints[j].name + " at q = " + number(q(k, j)) +
-                    " is far outside the rest of the reference [" + number(band.lo) + ", " +
-                    number(band.hi) + "]; fix that row of the reference (a corrupt value or unit)");
+                    model.joints[j].name + " at q = " + short_number(q(k, j)) +
+                    " is far outside the rest of the reference [" + short_number(band.lo) + ", " +
+                    short_number(band.hi) +
+                    "]; fix that row of the reference (a corrupt value or unit)");
       }
     }
   }
@@ -94,12 +89,12 @@ void check_simulated_run(const Model& model, const ClosedLoopResult& r, const Re
                          const SensorOptions& sensors) {
   if (!r.tau.allFinite()) {
     throw Error("simulate: the logged torques are not finite (torque noise std " +
-                number(sensors.torque_noise_std) +
+                short_number(sensors.torque_noise_std) +
                 " N·m, or an unstable plant); use a torque noise well below the torques");
   }
   if (!r.q.allFinite()) {
     throw Error("simulate: the logged positions are not finite (position noise std " +
-                number(sensors.position_noise_std) +
+                short_number(sensors.position_noise_std) +
                 " rad, or an unstable plant); use a realistic noise and check the reference");
   }
   for (Eigen::Index j = 0; j < r.q.cols(); ++j) {
@@ -108,8 +103,9 @@ void check_simulated_run(const Model& model, const ClosedLoopResult& r, const Re
     for (Eigen::Index k = 0; k < r.q.rows(); ++k) {
       if (!band.contains(r.q(k, j))) {
         throw Error("simulate: the closed loop diverged: joint " + model.joints[j].name +
-                    " reached q = " + number(r.q(k, j)) + " at t = " + number(r.t[k]) +
-                    " s while the reference stays in [" + number(band.lo) + ", " + number(band.hi) +
+                    " reached q = " + short_number(r.q(k, j)) + " at t = " + short_number(r.t[k]) +
+                    " s while the reference stays in [" + short_number(band.lo) + ", " +
+                    short_number(band.hi) +
                     "]; check the reference's dq and ddq columns (feed-forward) and the model's "
                     "masses and inertias");
       }

@@ -12,6 +12,10 @@ namespace dynid {
 /// one line of valid UTF-8 with no control characters; it is empty only when `text` is blank.
 std::string one_line(std::string_view text);
 
+/// `x` in 4 significant digits for messages ("1.6e+07", "0.2", "inf"), so that a value from the
+/// input never floods a message with hundreds of digits as std::to_string(1e300) would.
+std::string short_number(double x);
+
 /// `text` with every byte sequence that is not valid UTF-8 replaced by U+FFFD, for names that
 /// come from the input and are written into JSON (JSON text must be UTF-8).
 std::string valid_utf8(std::string_view text);
