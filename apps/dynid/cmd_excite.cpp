@@ -1,4 +1,5 @@
 // `dynid excite`: optimise a Fourier excitation and write the reference trajectory.
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -55,7 +56,17 @@ void run_excite(const ExciteCliOptions& o) {
   options.dq_max = limits(o.dq_max, model.dof(), "--velocity-limit");
   options.ddq_max = limits(o.ddq_max, model.dof(), "--acceleration-limit");
   options.tau_max = limits(o.tau_max, model.dof(), "--torque-limit");
+  if (o.harmonics < 2 && !o.no_rest) {
+    throw UsageError("--harmonics " + std::to_string(o.harmonics) +
+                     " leaves no free coefficient once the trajectory starts and ends at rest "
+                     "(dq = ddq = 0): use --harmonics 2 or more, or --no-rest");
+  }
   const ExcitationResult result = optimize_excitation(model, options);
+  if (!std::isfinite(result.condition_number)) {
+    throw Error("the optimised trajectory of '" + o.robot +
+                "' does not excite every base parameter (condition number infinite); use more "
+                "--harmonics, a higher --fmax or wider limits");
+  }
   std::cout << excitation_text(result);
   if (!o.json.empty()) write_json(o.json, excitation_to_json(result));
   write_trajectory_csv(o.out,

@@ -10,6 +10,7 @@
 
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/io/joint_record_file.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/io/streaming_identification.hpp"
@@ -36,6 +37,7 @@ struct IdentifyCliOptions {
   bool filter_coulomb = false;
   std::vector<double> torque_scale;
   std::string rows, time;
+  std::string outliers = "report";
 };
 
 // The run named by `flag` must be a readable file (so the error names the flag the user gave).
@@ -171,6 +173,10 @@ IdentifyOptions library_options(const IdentifyCliOptions& o) {
   out.signal.savitzky_golay = o.savgol;
   out.signal.torque_time_offset = o.torque_offset;
   out.signal.filter_coulomb_columns = o.filter_coulomb;
+  if (o.outliers != "report" && o.outliers != "drop") {
+    throw UsageError("--outliers must be report or drop, not '" + o.outliers + "'");
+  }
+  out.outliers.policy = o.outliers == "drop" ? OutlierPolicy::kDrop : OutlierPolicy::kReport;
   return out;
 }
 
@@ -190,6 +196,7 @@ nlohmann::json echo(const IdentifyCliOptions& o) {
           {"savitzky_golay", o.savgol},
           {"torque_offset_s", o.torque_offset},
           {"filter_coulomb_columns", o.filter_coulomb},
+          {"outliers", o.outliers},
           {"columns", o.columns},
           {"torque_scale", o.torque_scale},
           {"rows", o.rows},
@@ -272,6 +279,44 @@ void run_identify(const IdentifyCliOptions& o, const CLI::App& cmd) {
   std::cout << "wrote " << o.out << '\n';
 }
 
+// The options a result JSON records, read with the file and key named in any error (a wrong type
+// is the file's fault, not a command-line flag's).
+struct FileOptions {
+  const nlohmann::json& used;
+  const std::string& path;
+  template <typename T>
+  T get(const char* key, const T& fallback) const {
+    if (!used.contains(key)) return fallback;
+    try {
+      return used.at(key).get<T>();
+    } catch (const nlohmann::json::exception&) {
+      throw Error("'" + path + "': options." + key + " has the wrong type (" +
+                  used.at(key).type_name() + "); give the result.json of dynid identify unedited");
+    }
+  }
+};
+
+// A usage error raised by an option value read from a result file: the file and its key are at
+// fault, not the command-line flag the message names (exit 1, not 2).
+Error file_option_error(const UsageError& e, const std::string& path) {
+  static const std::pair<const char*, const char*> kKeys[] = {
+      {"--friction", "friction"},
+      {"--filter", "filter"},
+      {"--cutoff", "cutoff_hz"},
+      {"--torque-offset", "torque_offset_s"},
+      {"--zero-velocity", "zero_velocity"}};
+  std::string text = e.what();
+  for (const auto& [flag, key] : kKeys) {
+    if (text.rfind(flag, 0) == 0) {
+      text = "options." + std::string(key) + text.substr(std::string(flag).size());
+      break;
+    }
+  }
+  return Error("'" + path + "': " + text +
+               " (in the file; give the result.json of dynid identify "
+               "unedited)");
+}
+
 struct ValidateCliOptions {
   std::string robot, params, data, json, columns, mode = "torque", trajectory, engine = "mujoco";
   std::string predicted;
@@ -318,13 +363,14 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
   RunFileReport read;
   // The same friction set and signal processing as the identification that wrote the file.
   IdentifyCliOptions o;
-  o.friction = used.value("friction", o.friction);
-  o.no_armature = !used.value("armature", true);
-  o.filter = used.value("filter", o.filter);
-  o.cutoff = used.value("cutoff_hz", 0.0);
-  o.savgol = used.value("savitzky_golay", false);
-  o.torque_offset = used.value("torque_offset_s", 0.0);
-  o.filter_coulomb = used.value("filter_coulomb_columns", false);
+  const FileOptions file_options{used, v.params};
+  o.friction = file_options.get("friction", o.friction);
+  o.no_armature = !file_options.get("armature", true);
+  o.filter = file_options.get("filter", o.filter);
+  o.cutoff = file_options.get("cutoff_hz", 0.0);
+  o.savgol = file_options.get("savitzky_golay", false);
+  o.torque_offset = file_options.get("torque_offset_s", 0.0);
+  o.filter_coulomb = file_options.get("filter_coulomb_columns", false);
   // The rows left out are those below the thresholds identify used (stored in the result), not
   // thresholds recomputed from this run.
   if (!v.zero_velocity.empty()) {
@@ -336,15 +382,20 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
                            v.params + "')");
     }
   } else {
-    o.zero_velocity = used.value("zero_velocity", std::vector<double>{});
+    o.zero_velocity = file_options.get("zero_velocity", std::vector<double>{});
   }
   if (v.torque_scale.empty() && !cmd.count("--torque-scale")) {
-    file.torque_scale = used.value("torque_scale", std::vector<double>{});
+    file.torque_scale = file_options.get("torque_scale", std::vector<double>{});
     if (!file.torque_scale.empty()) {
       read.notes.push_back("--torque-scale as given to identify (stored in '" + v.params + "')");
     }
   }
-  const IdentifyOptions options = library_options(o);
+  IdentifyOptions options;
+  try {
+    options = library_options(o);
+  } catch (const UsageError& e) {
+    throw file_option_error(e, v.params);
+  }
   const JointRecord record = read_joint_record(v.data, model, file, &read);
   if (v.mode == "simulation") {
     RunFileOptions reference_file;
@@ -363,8 +414,22 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
     }
     return;
   }
-  const ValidationResult result = validate_torques(model, record, names, values, options);
+  ValidationResult result;
+  try {
+    result = validate_torques(model, record, names, values, options);
+  } catch (const UsageError& e) {  // --zero-velocity is the user's own when given
+    if (!v.zero_velocity.empty()) throw;
+    throw file_option_error(e, v.params);
+  }
   echo_choices("validate", read, result.choices);
+  if (!result.rms.allFinite() || !result.relative_error.allFinite() ||
+      !std::isfinite(result.relative_error_all) || !std::isfinite(result.relative_error_all_rows)) {
+    throw Error("the predicted torques overflow: the parameter values in '" + v.params +
+                "' (largest |value| " +
+                short_number(values.size() ? values.cwiseAbs().maxCoeff() : 0.0) +
+                ") or the torques in '" + v.data +
+                "' are implausibly large; check both files and their units");
+  }
   std::cout << validation_table(model, result);
   if (!v.json.empty()) {
     write_json(v.json, validation_to_json(model, result));
@@ -404,6 +469,10 @@ void add_identify_command(CLI::App& app) {
                   "on it beyond round-off")
       ->capture_default_str();
   add_signal_flags(cmd, *o);
+  cmd->add_option("--outliers", o->outliers,
+                  "Gross torque outliers (Hampel test): report (warn, keep them) or drop (replace "
+                  "each by its neighbours' median)")
+      ->capture_default_str();
   cmd->callback([o, cmd] { run_identify(*o, *cmd); });
 }
 

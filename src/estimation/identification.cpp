@@ -8,6 +8,7 @@
 
 #include "dynid/common/error.hpp"
 #include "dynid/estimation/least_squares.hpp"
+#include "dynid/estimation/outliers.hpp"
 #include "dynid/estimation/recursive_least_squares.hpp"
 #include "dynid/model/transmission.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
@@ -291,7 +292,8 @@ IdentificationResult identify(const Model& model, const JointRecord& record,
                               const IdentifyOptions& options) {
   const int n = model.dof();
   IdentificationResult result;
-  result.processed = preprocess_run(model, record, options.signal, result.choices);
+  const ScreenedRun screened = screen_run(model, record, options.outliers);  // outliers.hpp
+  result.processed = preprocess_run(model, screened.record, options.signal, result.choices);
   const JointRecord& r = result.processed.record;
   const Eigen::Index m = r.t.size();
   result.samples = m;
@@ -348,6 +350,7 @@ IdentificationResult identify(const Model& model, const JointRecord& record,
       result.estimate = recursive_least_squares(W, y, {}, eo);
       break;
   }
+  check_finite_estimate(result.estimate, screened);
   // Residuals per joint, unweighted, on the rows used.
   const Eigen::VectorXd e = y - W * result.estimate.x;
   Eigen::VectorXd e2 = Eigen::VectorXd::Zero(n), y2 = Eigen::VectorXd::Zero(n),
@@ -397,7 +400,9 @@ IdentificationResult identify(const Model& model, const JointRecord& record,
     const Eigen::VectorXd s = Eigen::BDCSVD<Eigen::MatrixXd>(W).singularValues();
     result.condition_number = s[s.size() - 1] > 0.0 ? s[0] / s[s.size() - 1] : INFINITY;
   }
-  result.warnings = result.estimate.summary.warnings;
+  result.warnings = screened.warnings;
+  result.warnings.insert(result.warnings.end(), result.estimate.summary.warnings.begin(),
+                         result.estimate.summary.warnings.end());
   return result;
 }
 

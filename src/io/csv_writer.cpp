@@ -22,6 +22,22 @@ void check_columns(const std::vector<std::string>& columns, Eigen::Index cols) {
   }
 }
 
+// The final guard of "no NaN or Inf leaves dynid": checked before the file is opened, so a refusal
+// leaves nothing behind. The producer should have named the input at fault already.
+void check_finite(const std::vector<std::string>& columns,
+                  const Eigen::Ref<const Eigen::MatrixXd>& data, const std::string& path) {
+  for (Eigen::Index i = 0; i < data.rows(); ++i) {
+    for (Eigen::Index c = 0; c < data.cols(); ++c) {
+      if (!std::isfinite(data(i, c))) {
+        throw Error(path + ": refusing to write the non-finite value of " +
+                    columns[static_cast<std::size_t>(c)] + " in data row " + std::to_string(i + 1) +
+                    " (nothing was written); an input gave a result that overflowed, check its "
+                    "units and values");
+      }
+    }
+  }
+}
+
 std::string header_line(const std::vector<std::string>& columns) {
   std::string s;
   for (std::size_t c = 0; c < columns.size(); ++c) {
@@ -55,6 +71,7 @@ void append_number(std::string& out, double value) {
 std::string format_csv(const std::vector<std::string>& columns,
                        const Eigen::Ref<const Eigen::MatrixXd>& data) {
   check_columns(columns, data.cols());
+  check_finite(columns, data, "CSV text");
   std::string out = header_line(columns);
   for (Eigen::Index i = 0; i < data.rows(); ++i) append_row(out, data, i);
   return out;
@@ -63,6 +80,7 @@ std::string format_csv(const std::vector<std::string>& columns,
 void write_csv(const std::string& path, const std::vector<std::string>& columns,
                const Eigen::Ref<const Eigen::MatrixXd>& data) {
   check_columns(columns, data.cols());
+  check_finite(columns, data, path);
   write_file_atomic(path, [&](std::ostream& out) {
     std::string buffer = header_line(columns);
     buffer.reserve(1 << 16);

@@ -1,5 +1,10 @@
 #include "dynid/io/inverse_dynamics_file.hpp"
 
+#include <algorithm>
+#include <string>
+
+#include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/dynamics/workspace.hpp"
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/io/csv_writer.hpp"
@@ -34,6 +39,14 @@ CsvTable inverse_dynamics_table(const Model& model, const CsvTable& states,
     dqi = dq.row(i).transpose();
     ddqi = ddq.row(i).transpose();
     rnea(model, ws, qi, dqi, ddqi, tau, rnea_options);
+    if (!tau.allFinite()) {
+      // Finite but huge states (dq = 1e155: dq² overflows) give Inf or NaN torques.
+      const std::string largest = short_number(std::max(
+          {qi.cwiseAbs().maxCoeff(), dqi.cwiseAbs().maxCoeff(), ddqi.cwiseAbs().maxCoeff()}));
+      throw Error(states.source + " line " + std::to_string(states.line_of(i)) +
+                  ": the torques overflow for these q, dq, ddq (largest |value| " + largest +
+                  "); check the row and the units (rad, rad/s, rad/s²)");
+    }
     out.data.row(i).segment(offset, n) = tau.transpose();
   }
   return out;

@@ -216,6 +216,33 @@ StreamingLeastSquares accumulate(const StreamSetup& s, const StreamingOptions& l
   return std::move(workers[0]->lsq);
 }
 
+// Signal processing a single pass over the file cannot do: refused by name instead of being
+// accepted and silently ignored (and then echoed as if applied).
+void reject_unsupported_signal_options(const SignalOptions& s) {
+  const SignalOptions defaults;
+  auto reject = [](const char* flag, const char* why) {
+    throw UsageError(std::string(flag) + " cannot be used with --stream (" + why + "); drop " +
+                     flag + " or drop --stream");
+  };
+  if (s.cutoff_hz != defaults.cutoff_hz) reject("--cutoff", "the stream is not filtered");
+  if (s.decimate != defaults.decimate) reject("--decimate", "every row is used");
+  if (s.trim != defaults.trim) reject("--trim", "there is no filter transient to trim");
+  if (s.savitzky_golay != defaults.savitzky_golay) {
+    reject("--savgol", "the stream uses the dq and ddq columns as given");
+  }
+  if (s.torque_time_offset != defaults.torque_time_offset) {
+    reject("--torque-offset", "re-interpolating the torques needs the whole record");
+  }
+  if (s.filter_coulomb_columns != defaults.filter_coulomb_columns) {
+    reject("--filter-coulomb", "the stream is not filtered");
+  }
+  for (const double v : s.zero_velocity) {
+    if (!(v >= 0.0 && std::isfinite(v))) {
+      throw UsageError("--zero-velocity values must be finite and >= 0 [rad/s]");
+    }
+  }
+}
+
 }  // namespace
 
 IdentificationResult identify_stream(const Model& model, const std::string& path,
@@ -228,6 +255,12 @@ IdentificationResult identify_stream(const Model& model, const std::string& path
   }
   if (options.estimator == IdentificationEstimator::kRls) {
     throw UsageError("streaming identification supports --estimator ols or wls");
+  }
+  reject_unsupported_signal_options(options.signal);
+  if (options.outliers.policy == OutlierPolicy::kDrop) {
+    throw UsageError(
+        "--outliers drop cannot be used with --stream (the outlier test needs each sample's "
+        "neighbours); drop --stream or clean the log");
   }
   if (stream.threads < 0) {
     throw UsageError("--threads is " + std::to_string(stream.threads) +

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/io/csv_writer.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/version.hpp"
@@ -128,7 +129,7 @@ IdentifiedResultFile read_identification_result(const std::string& path) {
   try {
     j = nlohmann::json::parse(f);
   } catch (const std::exception& ex) {
-    throw Error("'" + path + "' is not valid JSON (" + std::string(ex.what()) + ")");
+    throw Error("'" + path + "' is not valid JSON (" + one_line(ex.what()) + ")");
   }
   if (!j.is_object() || !j.contains("parameters") || !j["parameters"].is_array()) {
     throw Error("'" + path + "' has no 'parameters' list; give the result.json of dynid identify");
@@ -140,13 +141,20 @@ IdentifiedResultFile read_identification_result(const std::string& path) {
     if (!p.is_object() || !p.contains("name") || !p["name"].is_string() || !p.contains("value") ||
         !p["value"].is_number()) {
       throw Error("'" + path + "': parameters[" + std::to_string(i) +
-                  "] needs a name and a numeric value");
+                  "] needs a string name and a numeric value");
     }
     out.names.push_back(p["name"].get<std::string>());
     out.values[static_cast<Eigen::Index>(i)] = p["value"].get<double>();
+    if (!std::isfinite(out.values[static_cast<Eigen::Index>(i)])) {
+      throw Error("'" + path + "': parameters[" + std::to_string(i) +
+                  "].value overflows a double; give the result.json of dynid identify");
+    }
   }
   const auto options = j.find("options");
-  out.options = options != j.end() && options->is_object() ? *options : nlohmann::json::object();
+  if (options != j.end() && !options->is_object()) {
+    throw Error("'" + path + "': 'options' must be an object (as dynid identify writes it)");
+  }
+  out.options = options != j.end() ? *options : nlohmann::json::object();
   const auto model = j.find("model");
   if (model != j.end() && model->is_object()) {
     if (model->contains("name") && (*model)["name"].is_string()) {

@@ -1,5 +1,7 @@
 // MuJoCo plant: the model exported by to_urdf() and loaded from an in-memory VFS.
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <sstream>
 #include <string>
@@ -8,6 +10,7 @@
 #include <mujoco/mujoco.h>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/io/urdf_writer.hpp"
 #include "sim/plant_internal.hpp"
 
@@ -18,6 +21,33 @@ namespace {
 // Frictionloss constraint stiffness (see the constructor): time constant in steps, impedance.
 constexpr double kFrictionTimeConstantSteps = 2.0;
 constexpr double kFrictionImpedance = 0.9999;
+
+// MuJoCo prints its warnings to stdout, where they would mix with dynid's results: keep the last
+// one instead; step() turns the one that matters (divergence) into dynid's own error.
+thread_local std::string last_mujoco_warning;
+
+void keep_mujoco_warning(const char* message) {
+  last_mujoco_warning = message ? message : "";
+}
+
+// MuJoCo's default error handler prints and waits for Enter; it must not return (MuJoCo's C code
+// cannot be unwound by an exception), so it ends the process with dynid's one-line error. Output
+// files are only written after a simulation, so nothing is left half-written.
+void fail_on_mujoco_error(const char* message) {
+  std::fprintf(stderr, "error: MuJoCo failed: %s; use --engine native or check the model\n",
+               one_line(message ? message : "").c_str());
+  std::fflush(stderr);
+  std::_Exit(1);
+}
+
+void install_mujoco_handlers() {
+  static const bool installed = [] {
+    mju_user_warning = keep_mujoco_warning;
+    mju_user_error = fail_on_mujoco_error;
+    return true;
+  }();
+  (void)installed;
+}
 
 struct VfsDeleter {
   void operator()(mjVFS* vfs) const {
@@ -40,6 +70,7 @@ class MujocoPlant final : public Plant {
         q_(Eigen::VectorXd::Zero(n_)),
         dq_(Eigen::VectorXd::Zero(n_)),
         offset_(n_) {
+    install_mujoco_handlers();
     UrdfWriteOptions urdf_options;
     urdf_options.mujoco_compiler_tag = true;
     std::string urdf = to_urdf(model, urdf_options);
@@ -129,14 +160,16 @@ class MujocoPlant final : public Plant {
   void step(const Eigen::Ref<const Eigen::VectorXd>& tau) override {
     apply(tau);
     const int bad = d_->warning[mjWARN_BADQACC].number;
+    const double start = d_->time;  // MuJoCo resets the time with the state when it diverges
     mj_step(m_.get(), d_.get());
     for (int j = 0; j < n_; ++j) {
       q_[j] = d_->qpos[qpos_[j]];
       dq_[j] = d_->qvel[dof_[j]];
     }
     if (d_->warning[mjWARN_BADQACC].number != bad || !q_.allFinite() || !dq_.allFinite())
-      throw Error("mujoco plant: the simulation diverged at t = " + std::to_string(d_->time) +
-                  " s (MuJoCo reset it); lower the torque or the sample time dt");
+      throw Error("mujoco plant: the simulation diverged at t = " + std::to_string(start + dt_) +
+                  " s (MuJoCo: " + one_line(last_mujoco_warning) +
+                  "); check the reference and the model, lower the torque or the sample time dt");
   }
 
  private:

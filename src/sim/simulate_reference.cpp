@@ -1,8 +1,12 @@
 #include "dynid/sim/simulate_reference.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/dynamics/mass_matrix.hpp"
 #include "dynid/signal/sampling_check.hpp"
 
@@ -39,6 +43,76 @@ Reference periodic_reference(const Eigen::Ref<const Eigen::VectorXd>& t,
   return Reference{t.head(m), q.topRows(m), dq.topRows(m), ddq.topRows(m)};
 }
 
+// A tracking loop's positions stay near its reference: beyond the reference's robust span (1st to
+// 99th percentile, so a corrupt row does not widen it) by more than that span plus half a turn, a
+// value is a corrupt reference row or a plant gone unstable.
+constexpr double kDivergenceMargin = M_PI;
+constexpr double kBandPercentile = 0.01;
+
+struct Band {
+  double lo, hi;  // robust span of the reference
+  double margin;  // allowed distance outside [lo, hi]
+  bool contains(double x) const { return x >= lo - margin && x <= hi + margin; }
+};
+
+Band robust_band(const Eigen::Ref<const Eigen::VectorXd>& x) {
+  std::vector<double> v(x.data(), x.data() + x.size());
+  const auto at = [&](double p) {
+    const auto k = static_cast<std::ptrdiff_t>(p * static_cast<double>(v.size() - 1));
+    std::nth_element(v.begin(), v.begin() + k, v.end());
+    return v[static_cast<std::size_t>(k)];
+  };
+  const double lo = at(kBandPercentile), hi = at(1.0 - kBandPercentile);
+  return {lo, hi, (hi - lo) + kDivergenceMargin};
+}
+
+// Throws dynid::Error naming the first reference row far outside the rest of the reference.
+void check_reference_rows(const Model& model, const Eigen::Ref<const Eigen::MatrixXd>& q) {
+  for (Eigen::Index j = 0; j < q.cols(); ++j) {
+    const Band band = robust_band(q.col(j));
+    for (Eigen::Index k = 0; k < q.rows(); ++k) {
+      if (!band.contains(q(k, j))) {
+        throw Error("simulate: reference sample " + std::to_string(k + 1) + ": joint " +
+                    model.joints[j].name + " at q = " + short_number(q(k, j)) +
+                    " is far outside the rest of the reference [" + short_number(band.lo) + ", " +
+                    short_number(band.hi) +
+                    "]; fix that row of the reference (a corrupt value or unit)");
+      }
+    }
+  }
+}
+
+// Throws dynid::Error when the simulated run is not a tracking of the reference: a non-finite
+// logged value (sensor noise that overflows, an unstable plant), or a joint far outside the
+// reference's band (a plant driven unstable by the reference's feed-forward or by the model).
+void check_simulated_run(const Model& model, const ClosedLoopResult& r, const Reference& ref,
+                         const SensorOptions& sensors) {
+  if (!r.tau.allFinite()) {
+    throw Error("simulate: the logged torques are not finite (torque noise std " +
+                short_number(sensors.torque_noise_std) +
+                " N·m, or an unstable plant); use a torque noise well below the torques");
+  }
+  if (!r.q.allFinite()) {
+    throw Error("simulate: the logged positions are not finite (position noise std " +
+                short_number(sensors.position_noise_std) +
+                " rad, or an unstable plant); use a realistic noise and check the reference");
+  }
+  for (Eigen::Index j = 0; j < r.q.cols(); ++j) {
+    Band band = robust_band(ref.q.col(j));
+    band.margin += 10.0 * sensors.position_noise_std;
+    for (Eigen::Index k = 0; k < r.q.rows(); ++k) {
+      if (!band.contains(r.q(k, j))) {
+        throw Error("simulate: the closed loop diverged: joint " + model.joints[j].name +
+                    " reached q = " + short_number(r.q(k, j)) + " at t = " + short_number(r.t[k]) +
+                    " s while the reference stays in [" + short_number(band.lo) + ", " +
+                    short_number(band.hi) +
+                    "]; check the reference's dq and ddq columns (feed-forward) and the model's "
+                    "masses and inertias");
+      }
+    }
+  }
+}
+
 }  // namespace
 
 ClosedLoopResult simulate_reference(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& t,
@@ -48,11 +122,14 @@ ClosedLoopResult simulate_reference(const Model& model, const Eigen::Ref<const E
                                     SimulateOptions options) {
   const SamplingInfo info = require_uniform_sampling(t, 1e-6, "closed-loop simulation");
   const Reference ref = periodic_reference(t, q, dq, ddq);
+  check_reference_rows(model, ref.q);
   options.plant.dt = info.mean_period;
   auto plant = make_plant(model, options.plant);
   PidController pid(model, default_pid_options(model, q.row(0).transpose(), info.rate_hz()));
   Sensors sensors(model, options.sensors);
-  return run_closed_loop(ref, pid, *plant, sensors, options.loop);
+  ClosedLoopResult result = run_closed_loop(ref, pid, *plant, sensors, options.loop);
+  check_simulated_run(model, result, ref, options.sensors);
+  return result;
 }
 
 SimulationValidation validate_run_by_simulation(

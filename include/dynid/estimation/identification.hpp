@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 
 #include "dynid/estimation/estimate.hpp"
+#include "dynid/estimation/outlier_options.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
 #include "dynid/model/model.hpp"
 #include "dynid/regressor/parameter_layout.hpp"
@@ -67,6 +68,7 @@ struct IdentifyOptions {
   double confidence_level = 0.999;  ///< Student-t interval level (seed 2 Table 3)
   SignalOptions signal;             ///< filtering, derivatives, decimation, sample removal
   BaseParameterOptions base;        ///< base-parameter computation (layout is overwritten)
+  OutlierOptions outliers;          ///< gross torque outliers: report or drop (outliers.hpp)
 };
 
 /// The preprocessed data actually used for estimation (useful for plots and validation).

@@ -12,8 +12,8 @@ namespace dynid {
 void append_number(std::string& out, double value);
 
 /// CSV text: header line `columns` joined by commas, then one line per row of `data` (LF ends).
-/// Throws dynid::Error if columns.size() != data.cols() or a column name contains a comma,
-/// quote, newline or is empty.
+/// Throws dynid::Error if columns.size() != data.cols(), a column name contains a comma,
+/// quote, newline or is empty, or a value is NaN or infinite (naming its column and row).
 std::string format_csv(const std::vector<std::string>& columns,
                        const Eigen::Ref<const Eigen::MatrixXd>& data);
 

@@ -24,7 +24,9 @@ struct StreamingIdentificationOptions {
 /// summaries ((p_j+1)² numbers per joint, p_j = base columns joint j can see: links of its
 /// subtree and its own friction), and nothing proportional to the number of samples is kept.
 /// Requirements (else dynid::UsageError saying so): joint-side columns q*, dq*, ddq*, tau*; no
-/// filtering (options.signal.filter == false), since zero-phase filtering needs the whole record.
+/// filtering (options.signal.filter == false), since zero-phase filtering needs the whole record,
+/// and no other signal option away from its default (cut-off, decimation, trim, Savitzky–Golay,
+/// torque time offset, filtered Coulomb columns); finite, non-negative zero-velocity thresholds.
 /// Rows with |dq_j| below options.signal.zero_velocity are dropped when given (no automatic
 /// threshold: it would need a second pass). Estimators: OLS or WLS (Gautier, per-joint variance
 /// from the per-joint factors). Same result as identify() on the same rows, up to round-off.

@@ -27,7 +27,10 @@ struct SimulateOptions {
 /// Runs one periodic reference (t uniform, one period; a last sample equal to the first is the
 /// period's end and is dropped) in closed loop on the plant with default_pid_options() and
 /// returns the logged run (t, qr, q, tau, and the truth when asked). t: m, q/dq/ddq: m × n.
-/// Throws dynid::Error for a non-uniform or too short reference, or sizes that do not match.
+/// Throws dynid::Error for a non-uniform or too short reference, or sizes that do not match, for a
+/// reference row far outside the rest of the reference, and when the run is not a tracking of the
+/// reference: a non-finite logged value (noise that overflows, a plant gone unstable) or a joint
+/// leaving [P1 − span − π, P99 + span + π], P1/P99 the reference's percentiles, span = P99 − P1.
 ClosedLoopResult simulate_reference(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& t,
                                     const Eigen::Ref<const Eigen::MatrixXd>& q,
                                     const Eigen::Ref<const Eigen::MatrixXd>& dq,

@@ -1,0 +1,16 @@
+#pragma once
+
+// Checks of numeric flag values shared by every command: CLI11 parses "nan", "inf" and 1e999 into
+// a double without complaint, and most physical settings are meaningless below zero.
+
+#include <CLI/CLI.hpp>
+
+namespace dynid::cli {
+
+/// Adds to every numeric option of every subcommand of `app` a check that its value (each value
+/// of a list) is a finite number, and to the options listed in flag_checks.cpp a sign check
+/// (non-negative or positive). A failed check is a usage error naming the flag. Call once, after
+/// all subcommands are registered.
+void check_numeric_flags(CLI::App& app);
+
+}  // namespace dynid::cli

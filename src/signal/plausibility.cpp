@@ -1,0 +1,69 @@
+#include "dynid/signal/plausibility.hpp"
+
+#include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
+
+namespace dynid {
+namespace {
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> check_run_plausibility(const Eigen::Ref<const Eigen::VectorXd>& t,
+                                                const Eigen::Ref<const Eigen::MatrixXd>& q,
+                                                const Eigen::Ref<const Eigen::MatrixXd>& tau,
+                                                const std::vector<std::string>& joints,
+                                                const PlausibilityOptions& options) {
+  std::vector<std::string> warnings;
+  const Eigen::Index m = t.size();
+  if (m >= 2 && t[m - 1] > t[0]) {
+    const double rate = static_cast<double>(m - 1) / (t[m - 1] - t[0]);
+    if (rate < options.min_rate_hz || rate > options.max_rate_hz) {
+      throw Error("the time stamps give a sample rate of " + short_number(rate) + " Hz, outside " +
+                  short_number(options.min_rate_hz) + " Hz to " +
+                  short_number(options.max_rate_hz) +
+                  " Hz: t must be in seconds (divide milliseconds by 1000, microseconds by 1e6) "
+                  "or --rate must be in Hz");
+    }
+    if (rate < options.low_rate_hz) {
+      warnings.push_back("low sample rate " + short_number(rate) +
+                         " Hz: accelerations from so few samples are unreliable; if t is in "
+                         "milliseconds, convert it to seconds");
+    }
+  }
+  if (m == 0 || q.cols() == 0) return warnings;
+  std::vector<std::string> zero_torque, still;
+  for (Eigen::Index j = 0; j < tau.cols(); ++j) {
+    const std::string name =
+        j < static_cast<Eigen::Index>(joints.size()) ? joints[j] : "joint " + std::to_string(j + 1);
+    if (tau.col(j).cwiseAbs().maxCoeff() == 0.0) zero_torque.push_back(name);
+    if (q.col(j).maxCoeff() - q.col(j).minCoeff() < options.still_range) still.push_back(name);
+  }
+  if (static_cast<Eigen::Index>(zero_torque.size()) == tau.cols()) {
+    throw Error(
+        "the torque is zero in every sample of every joint: the torque columns were not "
+        "logged or hold something else; check the tau columns of the run");
+  }
+  if (static_cast<Eigen::Index>(still.size()) == q.cols()) {
+    throw Error("the run does not move (every joint's position range is below " +
+                short_number(options.still_range) +
+                " rad): record a run on an excitation trajectory (dynid excite, dynid simulate)");
+  }
+  if (!zero_torque.empty()) {
+    warnings.push_back("torque zero in every sample for " + join(zero_torque) +
+                       ": their parameters cannot be identified; check those tau columns");
+  }
+  if (!still.empty()) {
+    warnings.push_back(join(still) + " do not move (position range below " +
+                       short_number(options.still_range) +
+                       " rad): their parameters are not excited by this run");
+  }
+  return warnings;
+}
+
+}  // namespace dynid
