@@ -1,5 +1,6 @@
 // `dynid identify` and `dynid validate --mode torque`: parse, validate, call the library, write.
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -135,7 +136,11 @@ void add_signal_flags(CLI::App* cmd, IdentifyCliOptions& o) {
          "Zero-phase low-pass on q and tau: auto (Butterworth 4), none, butterworth[:ORDER], "
          "chebyshev[:ORDER[:RIPPLE_DB]] (default order 8, seed 2)")
       ->capture_default_str();
-  cmd->add_option("--cutoff", o.cutoff, "Filter cut-off [Hz]; 0 = min(20 Hz, rate/10)");
+  cmd->add_option("--cutoff", o.cutoff,
+                  "Filter cut-off [Hz], or auto (= 0, default): 1.5 x the highest frequency where "
+                  "the position spectrum stands 10 dB above its noise floor, in [1 Hz, min(20 Hz, "
+                  "rate/10)]")
+      ->transform(CLI::Transformer(std::map<std::string, std::string>{{"auto", "0"}}));
   cmd->add_option("--decimate", o.decimate,
                   "Keep every N-th sample after filtering; 0 = rate/(10·cut-off)");
   cmd->add_option("--trim", o.trim,
