@@ -5,6 +5,8 @@
 #include <limits>
 #include <string>
 
+#include <Eigen/Dense>
+#include <Eigen/SVD>
 #include <boost/math/distributions/students_t.hpp>
 
 #include "dynid/common/error.hpp"
@@ -111,15 +113,35 @@ HacSummary apply_hac_covariance(Estimate& e, const Eigen::Ref<const Eigen::Matri
   const Eigen::Index T = sample(m - 1) + 1;
   Eigen::MatrixXd G = Eigen::MatrixXd::Zero(T, p);
   for (Eigen::Index i = 0; i < m; ++i) G.row(sample(i)) += res(i) * W.row(i);
+  // Andrews–Monahan pre-whitening: V = residuals of a VAR(1) fitted to the scores.
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(p, p);
+  if (options.prewhiten && T > 2) {
+    const Eigen::MatrixXd M = G.topRows(T - 1).transpose() * G.topRows(T - 1);
+    const Eigen::MatrixXd C = G.bottomRows(T - 1).transpose() * G.topRows(T - 1);
+    A = M.completeOrthogonalDecomposition().solve(C.transpose()).transpose();
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Eigen::VectorXd sv = svd.singularValues().cwiseMin(0.97);
+    A = svd.matrixU() * sv.asDiagonal() * svd.matrixV().transpose();
+    const Eigen::MatrixXd V = G.bottomRows(T - 1) - G.topRows(T - 1) * A.transpose();
+    G = V;
+  }
+  const Eigen::Index Tv = G.rows();
+  double lag1 = 0.0;
   const int L = options.bandwidth >= 0
-                    ? static_cast<int>(std::min<Eigen::Index>(options.bandwidth, T - 1))
-                    : andrews_bandwidth(G, out.score_lag1);
+                    ? static_cast<int>(std::min<Eigen::Index>(options.bandwidth, Tv - 1))
+                    : andrews_bandwidth(G, lag1);
+  out.score_lag1 = lag1;
   out.bandwidth = L;
   Eigen::MatrixXd S = G.transpose() * G;
   for (int l = 1; l <= L; ++l) {
     const double w = 1.0 - static_cast<double>(l) / (L + 1.0);
-    const Eigen::MatrixXd gamma = G.bottomRows(T - l).transpose() * G.topRows(T - l);
+    const Eigen::MatrixXd gamma = G.bottomRows(Tv - l).transpose() * G.topRows(Tv - l);
     S += w * (gamma + gamma.transpose());
+  }
+  if (options.prewhiten && T > 2) {
+    const Eigen::MatrixXd R =
+        (Eigen::MatrixXd::Identity(p, p) - A).fullPivLu().solve(Eigen::MatrixXd::Identity(p, p));
+    S = R * S * R.transpose();
   }
   const Eigen::MatrixXd bread = e.covariance / e.residual_variance;
   const double dof_correction = static_cast<double>(m) / static_cast<double>(e.degrees_of_freedom);

@@ -24,6 +24,9 @@ struct HacOptions {
   /// Bartlett lag window: lags 0…bandwidth of the per-sample scores are summed. −1 = automatic,
   /// Andrews' (1991) AR(1) plug-in rule on the scores, capped at (samples − 1)/4.
   int bandwidth = -1;
+  /// Andrews–Monahan (1992) VAR(1) pre-whitening of the scores before the Bartlett window, then
+  /// recolouring: removes most of the kernel's downward bias under strong autocorrelation.
+  bool prewhiten = true;
 };
 
 /// What apply_hac_covariance found.
@@ -37,7 +40,9 @@ struct HacSummary {
 /// C = m/(m−r) · B·S·B with bread B = (WᵀW)⁻¹ = covariance/σ² (the estimator's own, so the
 /// weighting of WLS and the prior of RLS carry over), and meat S = Σ_|l|≤L (1 − |l|/(L+1))·Γ_l,
 /// Γ_l = Σ_k g_k g_{k−l}ᵀ, where the score g_k = Σ_{i: sample(i)=k} W_iᵀ·e_i sums the n joint rows
-/// of sample k (their residuals are correlated across joints too). Keeps the white statistics in
+/// of sample k (their residuals are correlated across joints too). With options.prewhiten the
+/// window runs on v_k = g_k − A·g_{k−1} (A the least-squares VAR(1) of the scores, singular
+/// values capped at 0.97) and S = (I − A)⁻¹ S_v (I − A)⁻ᵀ. Keeps the white statistics in
 /// std_dev_white / ci_*_white and refills std_dev, the intervals (same Student-t quantile) and
 /// the poorly-excited list. W (m×p) and e (m) must be the rows the estimator solved (weighted for
 /// WLS); sample (m entries, ≥ 0, non-decreasing) gives the time index of each row, gaps allowed.
