@@ -180,7 +180,11 @@ ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& option
         std::string(options.family == LowpassFamily::kButterworth ? "butterworth" : "chebyshev1") +
             " order " + std::to_string(options.order) + ", cut-off " + fmt(cutoff) +
             " Hz, zero phase, on q, dq, ddq and tau");
-    if (trim < 0) trim = static_cast<int>(std::ceil(3.0 * rate / cutoff));
+    if (trim < 0) {
+      // A low automatic cut-off must not consume a short run: keep at least half of it.
+      const auto cap = static_cast<int>(std::max<Eigen::Index>(0, (r.t.size() - 10) / 4));
+      trim = std::min(cap, static_cast<int>(std::ceil(3.0 * rate / cutoff)));
+    }
     if (decimate <= 0) decimate = std::max(1, static_cast<int>(std::floor(rate / (10.0 * cutoff))));
   } else {
     const bool given_dq = r.dq.size() != 0;
