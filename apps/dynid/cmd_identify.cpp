@@ -253,7 +253,7 @@ void add_identify_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--zero-velocity", o->zero_velocity,
                   "Drop rows of joint j with |dq_j| below this [rad/s] (1 or n values); "
-                  "default 1 % of max|dq_j|")
+                  "default max(1 % of max|dq_j|, 3 x its noise std), Coulomb columns filtered")
       ->delimiter(',');
   cmd->add_flag("--stream", o->stream,
                 "Constant-memory mode for very long runs: reads the file in chunks; needs q, dq, "
