@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -227,7 +228,11 @@ void add_signal_flags(CLI::App* cmd, IdentifyCliOptions& o) {
          "chebyshev[:ORDER[:RIPPLE_DB]] (default order 8, as in B. Bona, A. Curatella, "
          "Closed-loop rigid model identification of an industrial robot, 2005)")
       ->capture_default_str();
-  cmd->add_option("--cutoff", o.cutoff, "Filter cut-off [Hz]; 0 = min(20 Hz, rate/10)");
+  cmd->add_option("--cutoff", o.cutoff,
+                  "Filter cut-off [Hz], or auto (= 0, default): 1.5 x the highest frequency where "
+                  "the position spectrum stands 10 dB above its noise floor, in [1 Hz, min(20 Hz, "
+                  "rate/10)]")
+      ->transform(CLI::Transformer(std::map<std::string, std::string>{{"auto", "0"}}));
   cmd->add_option("--decimate", o.decimate,
                   "Keep every N-th sample after filtering; 0 = rate/(10·cut-off)");
   cmd->add_option("--trim", o.trim,
@@ -459,7 +464,7 @@ void add_identify_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--zero-velocity", o->zero_velocity,
                   "Drop rows of joint j with |dq_j| below this [rad/s] (1 or n values); "
-                  "default 1 % of max|dq_j|")
+                  "default max(1 % of max|dq_j|, 3 x its noise std), Coulomb columns filtered")
       ->delimiter(',');
   cmd->add_flag("--stream", o->stream,
                 "Constant-memory mode for very long runs: reads the file in chunks; needs q, dq, "

@@ -10,9 +10,11 @@
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/outliers.hpp"
 #include "dynid/estimation/recursive_least_squares.hpp"
+#include "dynid/estimation/statistics.hpp"
 #include "dynid/model/transmission.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
 #include "dynid/signal/differentiation.hpp"
+#include "dynid/signal/noise_floor.hpp"
 #include "dynid/signal/resampling.hpp"
 #include "dynid/signal/sampling_check.hpp"
 #include "dynid/signal/zero_phase_filter.hpp"
@@ -135,9 +137,20 @@ ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& option
   double cutoff = options.cutoff_hz;
   int trim = options.trim;
   int decimate = options.decimate;
+  double out_noise_gain = 0.0;
   SosFilter filter;
+  NoiseFloor floor;
   if (options.filter) {
-    if (cutoff <= 0.0) cutoff = std::min(20.0, rate / 10.0);
+    if (cutoff <= 0.0) {
+      CutoffChoice c = choose_cutoff(r.q, rate);
+      cutoff = c.cutoff_hz;
+      floor = std::move(c.floor);
+      choices.emplace_back("cutoff", c.reason);
+      choices.emplace_back("cutoff_hz", fmt(cutoff));
+    } else {
+      choices.emplace_back("cutoff", fmt(cutoff) + " Hz (given)");
+      choices.emplace_back("cutoff_hz", fmt(cutoff));
+    }
     LowpassOptions lp;
     lp.family = options.family;
     lp.order = options.order;
@@ -153,6 +166,12 @@ ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& option
       dc *= (row(0) + row(1) + row(2)) / (row(3) + row(4) + row(5));
     }
     filter.sos.row(0).head<3>() /= dc;
+    // Noise of the velocity as processed: from the position's noise floor through filter and
+    // central differences, or from the given velocity's floor through the filter.
+    const bool given_dq = r.dq.size() != 0;
+    if (given_dq) floor = position_noise_floor(r.dq, rate);
+    if (floor.noise_std.size() == 0) floor = position_noise_floor(r.q, rate);
+    out_noise_gain = white_noise_gain(&filter, given_dq ? 0 : 1, rate);
     r.q = filtfilt(filter, r.q);
     r.tau = filtfilt(filter, r.tau);
     if (r.dq.size()) r.dq = filtfilt(filter, r.dq);
@@ -162,9 +181,16 @@ ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& option
         std::string(options.family == LowpassFamily::kButterworth ? "butterworth" : "chebyshev1") +
             " order " + std::to_string(options.order) + ", cut-off " + fmt(cutoff) +
             " Hz, zero phase, on q, dq, ddq and tau");
-    if (trim < 0) trim = static_cast<int>(std::ceil(3.0 * rate / cutoff));
+    if (trim < 0) {
+      // A low automatic cut-off must not consume a short run: keep at least half of it.
+      const auto cap = static_cast<int>(std::max<Eigen::Index>(0, (r.t.size() - 10) / 4));
+      trim = std::min(cap, static_cast<int>(std::ceil(3.0 * rate / cutoff)));
+    }
     if (decimate <= 0) decimate = std::max(1, static_cast<int>(std::floor(rate / (10.0 * cutoff))));
   } else {
+    const bool given_dq = r.dq.size() != 0;
+    floor = position_noise_floor(given_dq ? r.dq : r.q, rate);
+    out_noise_gain = white_noise_gain(nullptr, given_dq ? 0 : 1, rate);
     choices.emplace_back("filter", "none");
     if (trim < 0) trim = 0;
     if (decimate <= 0) decimate = 1;
@@ -205,13 +231,29 @@ ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& option
   out.record.ddq = take_rows(r.ddq, first, last, decimate);
   out.record.tau = take_rows(r.tau, first, last, decimate);
   out.rate_hz = rate / decimate;
-  if (options.filter_coulomb_columns && options.filter) {
-    const Eigen::MatrixXd pos = (r.dq.array() > 0.0).cast<double>().matrix();
-    const Eigen::MatrixXd neg = (r.dq.array() < 0.0).cast<double>().matrix();
+  out.cutoff_hz = options.filter ? cutoff : 0.0;
+  out.position_noise_std =
+      floor.noise_std.unaryExpr([](double v) { return std::isfinite(v) ? v : 0.0; });
+  out.velocity_noise_std = out_noise_gain * out.position_noise_std;
+  if (options.filter && (options.filter_coulomb_columns || options.zero_velocity.empty())) {
+    // Expected sign of the true velocity given the noisy one (Gaussian noise σ_dq, flat prior):
+    // E[sign(dq)] = erf(dq̂/(√2σ)); its halves are the moving-positive/-negative indicators.
+    Eigen::MatrixXd pos(r.dq.rows(), r.dq.cols()), neg(r.dq.rows(), r.dq.cols());
+    for (Eigen::Index j = 0; j < r.dq.cols(); ++j) {
+      const double sigma = out.velocity_noise_std[j];
+      for (Eigen::Index k = 0; k < r.dq.rows(); ++k) {
+        const double v = r.dq(k, j);
+        const double s = sigma > 0.0 ? std::erf(v / (std::sqrt(2.0) * sigma))
+                                     : static_cast<double>((v > 0.0) - (v < 0.0));
+        pos(k, j) = sigma > 0.0 ? 0.5 * (1.0 + s) : static_cast<double>(v > 0.0);
+        neg(k, j) = sigma > 0.0 ? 0.5 * (1.0 - s) : static_cast<double>(v < 0.0);
+      }
+    }
     out.moving_positive = take_rows(filtfilt(filter, pos), first, last, decimate);
     out.moving_negative = take_rows(filtfilt(filter, neg), first, last, decimate);
     choices.emplace_back("coulomb_columns",
-                         "sign(dq) filtered like tau at the full rate (parallel filtering)");
+                         "expected sign erf(dq/(sqrt(2) sigma_dq)) of the velocity, filtered like "
+                         "tau at the full rate (parallel filtering)");
   }
   return out;
 }
@@ -269,19 +311,38 @@ ProcessedRecord preprocess_run(const Model& model, const JointRecord& record,
 constexpr double kCorrelatedResidualWarning = 0.5;
 
 // Rows of joint j where |dq_j| is below threshold_j, too small for sign(dq_j) to be meaningful, are
-// left out when the layout has Coulomb friction: given values (1 or n), or by default 1 % of
-// max|dq_j| of the processed record (on the TX40 this reproduces FIGAROH's thresholds). Zero
-// without Coulomb friction. The choice is appended to `choices`.
-Eigen::VectorXd zero_velocity_threshold(const IdentifyOptions& options, const Eigen::MatrixXd& dq,
-                                        const char* verb,
+// left out when the layout has Coulomb friction: given values (1 or n), or by default
+// zero_velocity_noise_multiple × the processed velocity's noise std (where the sign of dq is not
+// known from the data). Zero without Coulomb friction. The choice is appended to `choices`.
+Eigen::VectorXd zero_velocity_threshold(const IdentifyOptions& options,
+                                        const ProcessedRecord& processed, const char* verb,
                                         std::vector<std::pair<std::string, std::string>>& choices) {
-  const auto n = dq.cols();
+  const auto n = processed.record.dq.cols();
   Eigen::VectorXd threshold = Eigen::VectorXd::Zero(n);
   if (!options.layout.coulomb) return threshold;
   threshold = given_zero_velocity(options.signal.zero_velocity, static_cast<int>(n));
-  if (threshold.size() == 0) threshold = 0.01 * dq.cwiseAbs().colwise().maxCoeff().transpose();
   std::ostringstream s;
-  s << "rows with |dq_j| < [" << threshold.transpose() << "] " << verb << " (Coulomb friction)";
+  s << std::setprecision(3);
+  if (threshold.size() == 0) {
+    const double k = options.signal.zero_velocity_noise_multiple;
+    if (!(k >= 0.0) || !std::isfinite(k)) {
+      throw UsageError("zero_velocity_noise_multiple " + fmt(k) + " is not >= 0; use e.g. 3");
+    }
+    const double f = options.signal.zero_velocity_fraction;
+    if (!(f >= 0.0 && f < 1.0)) {
+      throw UsageError("zero_velocity_fraction " + fmt(f) + " is not in [0, 1); use e.g. 0.01");
+    }
+    const Eigen::VectorXd band =
+        f * processed.record.dq.cwiseAbs().colwise().maxCoeff().transpose();
+    threshold = band.cwiseMax(k * processed.velocity_noise_std);
+    s << "auto: rows with |dq_j| < [" << threshold.transpose() << "] " << verb << " = max(" << f
+      << " x max|dq_j| (real friction leaves the Coulomb law there), " << k
+      << " x the velocity noise std [" << processed.velocity_noise_std.transpose()
+      << "] (the sign of dq is unknown there)); Coulomb columns: the filtered expected sign, "
+         "which keeps Fv and Fc unbiased when the cut-off smears the Coulomb step";
+  } else {
+    s << "rows with |dq_j| < [" << threshold.transpose() << "] " << verb << " (given)";
+  }
   choices.emplace_back("zero_velocity", s.str());
   return threshold;
 }
@@ -309,7 +370,7 @@ IdentificationResult identify(const Model& model, const JointRecord& record,
   result.rank = result.base.rank;
 
   const Eigen::VectorXd threshold =
-      zero_velocity_threshold(options, r.dq, "removed", result.choices);
+      zero_velocity_threshold(options, result.processed, "removed", result.choices);
   result.zero_velocity_threshold = threshold;
   const bool coulomb = options.layout.coulomb;
   const Eigen::MatrixXd W_full =
@@ -384,14 +445,43 @@ IdentificationResult identify(const Model& model, const JointRecord& record,
         worst = std::max(worst, result.residual_autocorrelation[j]);
       }
     }
+    // Default intervals: HAC sandwich over samples (the estimator's own bread, so WLS weights and
+    // the RLS prior carry over); the white-noise ones stay as std_white.
+    Eigen::MatrixXd Ws = W;
+    Eigen::VectorXd es = e;
+    if (options.estimator == IdentificationEstimator::kWls) {
+      for (Eigen::Index i = 0; i < rows; ++i) {
+        const double v = result.estimate.group_variance[groups[i]];
+        const double w = v > 0.0 && std::isfinite(v) ? 1.0 / std::sqrt(v) : 1.0;
+        Ws.row(i) *= w;
+        es[i] *= w;
+      }
+    }
+    Eigen::VectorXi sample(rows);
+    for (Eigen::Index i = 0; i < rows; ++i) sample[i] = static_cast<int>(keep[i] / n);
+    HacOptions hac;
+    hac.bandwidth = options.hac_bandwidth;
+    const HacSummary h = apply_hac_covariance(result.estimate, Ws, es, sample, eo, hac);
+    std::ostringstream c;
+    c << std::setprecision(3);
+    if (result.estimate.covariance_kind == "white") {
+      c << "white-noise sigma^2 (W^T W)^-1 (no residual degrees of freedom for a sandwich)";
+    } else {
+      c << "Newey-West (HAC) sandwich over samples, Bartlett window of " << h.bandwidth
+        << " samples (" << (options.hac_bandwidth >= 0 ? "given" : "Andrews AR(1) rule")
+        << "): std and ci_* allow for correlated residuals (filtering, unmodelled dynamics); "
+           "std_white assumes white residuals and is "
+        << h.median_ratio << "x smaller (median)";
+    }
+    result.choices.emplace_back("covariance", c.str());
     if (!correlated.empty()) {
       std::ostringstream w;
       w << "residuals of " << correlated << " are correlated (lag-1 autocorrelation up to "
         << std::setprecision(2) << worst
-        << "): the intervals assume white residuals and, for AR(1) residuals, are too narrow by "
-           "about "
-        << std::setprecision(2) << std::sqrt((1.0 + worst) / (1.0 - std::min(worst, 0.999)))
-        << "x (filtered noise or dynamics the model lacks); judge the model on a validation run";
+        << "): filtered noise or dynamics the model lacks; std/ci_* account for it (HAC), "
+           "std_white would be about "
+        << std::setprecision(2) << h.median_ratio
+        << "x too narrow; judge the model on a validation run";
       result.estimate.summary.warnings.push_back(w.str());
     }
   }
@@ -442,8 +532,8 @@ ValidationResult validate_torques(const Model& model, const JointRecord& record,
           pred.data(), m, n);
   // Errors on the joint equations identify() would use: near-zero-velocity rows of a Coulomb
   // model are left out the same way (their sign(dq) is noise), and reported apart.
-  const Eigen::VectorXd threshold =
-      zero_velocity_threshold(options, r.dq, "left out of the error statistics", out.choices);
+  const Eigen::VectorXd threshold = zero_velocity_threshold(
+      options, out.processed, "left out of the error statistics", out.choices);
   out.zero_velocity_threshold = threshold;
   const Eigen::MatrixXd e = r.tau - out.predicted;
   Eigen::VectorXd e2 = Eigen::VectorXd::Zero(n), y2 = Eigen::VectorXd::Zero(n),

@@ -1,9 +1,12 @@
 #include "dynid/estimation/statistics.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 
+#include <Eigen/Dense>
+#include <Eigen/SVD>
 #include <boost/math/distributions/students_t.hpp>
 
 #include "dynid/common/error.hpp"
@@ -54,6 +57,111 @@ void fill_parameter_statistics(Estimate& e, const EstimationOptions& options) {
   for (Eigen::Index j = 0; j < p; ++j) {
     if (e.relative_std_percent(j) > options.poorly_excited_percent) e.poorly_excited.push_back(j);
   }
+}
+
+namespace {
+
+// Andrews' (1991) AR(1) plug-in bandwidth for the Bartlett kernel, L = 1.1447·(α̂·T)^(1/3), with
+// each score component standardised (unit weights on the standardised series make the rule
+// independent of the parameters' units). ρ is capped at 0.97: beyond, the plug-in explodes while
+// the cap at T/4 decides anyway.
+int andrews_bandwidth(const Eigen::MatrixXd& G, double& mean_rho) {
+  const Eigen::Index T = G.rows();
+  double num = 0.0, den = 0.0, rho_sum = 0.0;
+  int used = 0;
+  for (Eigen::Index a = 0; a < G.cols(); ++a) {
+    const Eigen::VectorXd g = G.col(a);
+    const double lagged = g.head(T - 1).squaredNorm();
+    if (!(lagged > 0.0)) continue;
+    double rho = g.tail(T - 1).dot(g.head(T - 1)) / lagged;
+    rho = std::clamp(rho, -0.97, 0.97);
+    rho_sum += rho;
+    ++used;
+    num += 4.0 * rho * rho / (std::pow(1.0 - rho, 6) * std::pow(1.0 + rho, 2));
+    den += 1.0 / std::pow(1.0 - rho, 4);
+  }
+  mean_rho = used ? rho_sum / used : 0.0;
+  if (!(den > 0.0)) return 0;
+  const double L = 1.1447 * std::cbrt(num / den * static_cast<double>(T));
+  return static_cast<int>(std::min(std::ceil(L), std::floor((T - 1) / 4.0)));
+}
+
+}  // namespace
+
+HacSummary apply_hac_covariance(Estimate& e, const Eigen::Ref<const Eigen::MatrixXd>& W,
+                                const Eigen::Ref<const Eigen::VectorXd>& res,
+                                const Eigen::Ref<const Eigen::VectorXi>& sample,
+                                const EstimationOptions& estimation_options,
+                                const HacOptions& options) {
+  const Eigen::Index m = W.rows(), p = W.cols();
+  if (res.size() != m || sample.size() != m || e.x.size() != p || e.covariance.rows() != p) {
+    throw Error("apply_hac_covariance: W is " + std::to_string(m) + "×" + std::to_string(p) +
+                ", e has " + std::to_string(res.size()) + " and sample " +
+                std::to_string(sample.size()) + " entries, the estimate " +
+                std::to_string(e.x.size()) + " parameters; pass the rows the estimator solved");
+  }
+  HacSummary out;
+  if (m == 0 || !(e.residual_variance > 0.0) || e.degrees_of_freedom <= 0) return out;
+  if (sample(0) < 0) throw Error("apply_hac_covariance: sample indices must be >= 0");
+  for (Eigen::Index i = 1; i < m; ++i) {
+    if (sample(i) < sample(i - 1)) {
+      throw Error("apply_hac_covariance: sample index decreases at row " + std::to_string(i) +
+                  "; pass the rows in time order");
+    }
+  }
+  // Per-sample scores g_k = Σ W_iᵀ e_i; samples without rows keep a zero score (gaps).
+  const Eigen::Index T = sample(m - 1) + 1;
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(T, p);
+  for (Eigen::Index i = 0; i < m; ++i) G.row(sample(i)) += res(i) * W.row(i);
+  // Andrews–Monahan pre-whitening: V = residuals of a VAR(1) fitted to the scores.
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(p, p);
+  if (options.prewhiten && T > 2) {
+    const Eigen::MatrixXd M = G.topRows(T - 1).transpose() * G.topRows(T - 1);
+    const Eigen::MatrixXd C = G.bottomRows(T - 1).transpose() * G.topRows(T - 1);
+    A = M.completeOrthogonalDecomposition().solve(C.transpose()).transpose();
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Eigen::VectorXd sv = svd.singularValues().cwiseMin(0.97);
+    A = svd.matrixU() * sv.asDiagonal() * svd.matrixV().transpose();
+    const Eigen::MatrixXd V = G.bottomRows(T - 1) - G.topRows(T - 1) * A.transpose();
+    G = V;
+  }
+  const Eigen::Index Tv = G.rows();
+  double lag1 = 0.0;
+  const int L = options.bandwidth >= 0
+                    ? static_cast<int>(std::min<Eigen::Index>(options.bandwidth, Tv - 1))
+                    : andrews_bandwidth(G, lag1);
+  out.score_lag1 = lag1;
+  out.bandwidth = L;
+  Eigen::MatrixXd S = G.transpose() * G;
+  for (int l = 1; l <= L; ++l) {
+    const double w = 1.0 - static_cast<double>(l) / (L + 1.0);
+    const Eigen::MatrixXd gamma = G.bottomRows(Tv - l).transpose() * G.topRows(Tv - l);
+    S += w * (gamma + gamma.transpose());
+  }
+  if (options.prewhiten && T > 2) {
+    const Eigen::MatrixXd R =
+        (Eigen::MatrixXd::Identity(p, p) - A).fullPivLu().solve(Eigen::MatrixXd::Identity(p, p));
+    S = R * S * R.transpose();
+  }
+  const Eigen::MatrixXd bread = e.covariance / e.residual_variance;
+  const double dof_correction = static_cast<double>(m) / static_cast<double>(e.degrees_of_freedom);
+  const Eigen::VectorXd white = e.std_dev;
+  e.covariance = dof_correction * bread * S * bread;
+  e.covariance = 0.5 * (e.covariance + e.covariance.transpose());
+  fill_parameter_statistics(e, estimation_options);
+  e.std_dev_white = white;
+  e.ci_lower_white = e.x - e.t_quantile * white;
+  e.ci_upper_white = e.x + e.t_quantile * white;
+  e.covariance_kind = "hac_bartlett";
+  std::vector<double> ratio;
+  for (Eigen::Index j = 0; j < p; ++j) {
+    if (white(j) > 0.0 && std::isfinite(white(j))) ratio.push_back(e.std_dev(j) / white(j));
+  }
+  if (!ratio.empty()) {
+    std::nth_element(ratio.begin(), ratio.begin() + ratio.size() / 2, ratio.end());
+    out.median_ratio = ratio[ratio.size() / 2];
+  }
+  return out;
 }
 
 }  // namespace dynid

@@ -355,6 +355,10 @@ IdentificationResult identify_stream(const Model& model, const std::string& path
   result.choices.emplace_back("accumulation", accumulation);
   result.choices.emplace_back("threads", std::to_string(threads) + " workers + 1 reader");
   result.zero_velocity_threshold = s.threshold;
+  result.choices.emplace_back("covariance",
+                              "white-noise sigma^2 (W^T W)^-1 (the stream keeps no residual "
+                              "series for a HAC sandwich): too narrow if the residuals are "
+                              "correlated; identify without --stream for intervals that allow it");
   result.samples = samples;
   result.rows = lsq.rows();
   result.residual_rms = result.estimate.group_rms;

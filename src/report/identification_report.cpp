@@ -67,6 +67,11 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
                       {"ci_low", json_number(e.ci_lower[k])},
                       {"ci_high", json_number(e.ci_upper[k])},
                       {"expression", r.expressions[i]}});
+    if (e.std_dev_white.size() == e.x.size()) {
+      params.back()["std_white"] = json_number(e.std_dev_white[k]);
+      params.back()["ci_white_low"] = json_number(e.ci_lower_white[k]);
+      params.back()["ci_white_high"] = json_number(e.ci_upper_white[k]);
+    }
   }
   nlohmann::json choices = nlohmann::json::object();
   for (const auto& [k, v] : r.choices) choices[k] = v;

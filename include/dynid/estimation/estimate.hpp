@@ -65,6 +65,13 @@ struct Estimate {
   double t_quantile = 0.0;               ///< Student-t quantile t with P(|T| ≤ t) = level
   Eigen::VectorXd ci_lower;              ///< x − t·σ_x
   Eigen::VectorXd ci_upper;              ///< x + t·σ_x
+  /// σ_x of the white-noise covariance σ²·(WᵀW)⁻¹ when `covariance` was replaced by a sandwich
+  /// (apply_hac_covariance); else empty. Too narrow when the residuals are correlated.
+  Eigen::VectorXd std_dev_white;
+  Eigen::VectorXd ci_lower_white;  ///< x − t·std_dev_white (empty like std_dev_white)
+  Eigen::VectorXd ci_upper_white;  ///< x + t·std_dev_white (empty like std_dev_white)
+  /// Which covariance `covariance`, std_dev and the intervals come from ("white" or a HAC rule).
+  std::string covariance_kind = "white";
   double residual_variance = 0.0;  ///< σ² = ‖e‖²/(m − rank) (weighted residual for WLS)
   Eigen::Index degrees_of_freedom = 0;   ///< m − rank
   double residual_rms = 0.0;             ///< sqrt(‖e‖²/m), unweighted

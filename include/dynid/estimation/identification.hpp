@@ -30,22 +30,36 @@ struct SignalOptions {
       true;  ///< zero-phase low-pass of q and tau with the same filter (parallel filtering)
   LowpassFamily family = LowpassFamily::kButterworth;  ///< filter prototype
   int order = 4;                                       ///< filter order
-  double cutoff_hz = 0.0;  ///< 0 = auto: min(20 Hz, rate/10) (arm dynamics live below ~10 Hz)
+  /// Low-pass cut-off [Hz]; 0 = auto: choose_cutoff() (signal/noise_floor.hpp), 1.5 × the upper
+  /// end of the band where the position spectrum stands 20 dB above its noise floor, in
+  /// [1 Hz, min(20 Hz, rate/10)].
+  double cutoff_hz = 0.0;
   double ripple_db = 0.5;  ///< Chebyshev I passband ripple
   int decimate = 0;        ///< keep every k-th sample; 0 = auto: rate/(10·cutoff), ≥ 1
   int trim = -1;  ///< samples dropped at each end after filtering; −1 = auto: 3·rate/cutoff
   bool savitzky_golay =
       false;  ///< differentiate with Savitzky–Golay instead of central differences
   /// Coulomb friction is undefined near dq = 0: rows of joint j with |dq_j| below the threshold are
-  /// removed. Empty = auto: 1 % of max|dq_j| per joint. One value = all joints; else n values.
+  /// removed. One value = all joints; else n values. Empty = auto: threshold_j =
+  /// max(zero_velocity_fraction·max|dq_j|, zero_velocity_noise_multiple·σ_dq,j) (real joints leave
+  /// the Coulomb law below a physical velocity band; below the noise the sign of dq is unknown),
+  /// and the Coulomb columns are the filtered expected sign (as with filter_coulomb_columns): with
+  /// a low cut-off the filtered torque's smeared Coulomb step otherwise biases Fv high and Fc low
+  /// (docs/methods/estimation.md, "Friction near zero velocity").
   std::vector<double> zero_velocity;
+  /// Automatic zero-velocity rule: fraction of max|dq_j| of the processed record (the band where
+  /// real joint friction is not Fc·sign(dq): pre-sliding, Stribeck; 1 % matches FIGAROH's TX40).
+  double zero_velocity_fraction = 0.01;
+  /// Automatic zero-velocity rule: multiple k of the processed velocity's noise std σ_dq.
+  double zero_velocity_noise_multiple = 3.0;
   /// The torque logged at time stamp t acts at t + torque_time_offset [s]; the torques are
   /// re-interpolated (linearly) onto the position time stamps before filtering. A controller that
   /// logs the command it then holds for one period (zero-order hold, as `dynid simulate` does)
   /// needs +T/2: central differences centre q̈ on the sample, the held torque half a period later.
   /// A torque sensor lagging by d needs −d. 0 = as logged.
   double torque_time_offset = 0.0;
-  /// Filter the Coulomb columns of the regressor (sign(dq), or [dq>0] and −[dq<0]) with the same
+  /// Filter the Coulomb columns of the regressor (sign(dq), or [dq>0] and −[dq<0]; with a known
+  /// velocity noise σ_dq the expected sign erf(dq/(√2·σ_dq)) and its halves) with the same
   /// zero-phase filter as tau, from the full-rate velocity (Gautier's parallel filtering applied to
   /// the one discontinuous column): the filtered torque's smeared Coulomb step at a velocity
   /// reversal is then matched by the model instead of biasing Fv and Fc. Only with `filter`;
@@ -66,9 +80,11 @@ struct IdentifyOptions {
   bool coupling = true;  ///< add the coupled-motor columns when the transmission couples joints
   IdentificationEstimator estimator = IdentificationEstimator::kOls;  ///< batch or recursive
   double confidence_level = 0.999;  ///< Student-t interval level (seed 2 Table 3)
-  SignalOptions signal;             ///< filtering, derivatives, decimation, sample removal
-  BaseParameterOptions base;        ///< base-parameter computation (layout is overwritten)
-  OutlierOptions outliers;          ///< gross torque outliers: report or drop (outliers.hpp)
+  /// Bartlett window (samples) of the HAC covariance behind std/ci_*; −1 = automatic (Andrews).
+  int hac_bandwidth = -1;
+  SignalOptions signal;       ///< filtering, derivatives, decimation, sample removal
+  BaseParameterOptions base;  ///< base-parameter computation (layout is overwritten)
+  OutlierOptions outliers;    ///< gross torque outliers: report or drop (outliers.hpp)
 };
 
 /// The preprocessed data actually used for estimation (useful for plots and validation).
@@ -78,6 +94,10 @@ struct ProcessedRecord {
   /// With SignalOptions::filter_coulomb_columns: [dq_j > 0] and [dq_j < 0] at the full rate,
   /// filtered like tau, trimmed and decimated like `record` (m × n each); else empty.
   Eigen::MatrixXd moving_positive, moving_negative;
+  double cutoff_hz = 0.0;  ///< low-pass cut-off used [Hz]; 0 without filter
+  /// Per joint, std of the white position noise floor of the input (position_noise_floor) and of
+  /// the resulting noise on the processed velocity [rad/s or m/s]; 0 when not measurable.
+  Eigen::VectorXd position_noise_std, velocity_noise_std;
 };
 
 /// Sample-major regressor of a processed record (stacked_regressor), with the Coulomb columns

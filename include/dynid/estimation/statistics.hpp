@@ -19,4 +19,39 @@ double student_t_quantile(double level, double dof);
 /// Throws dynid::Error if options.confidence_level ∉ (0, 1).
 void fill_parameter_statistics(Estimate& estimate, const EstimationOptions& options);
 
+/// Options of apply_hac_covariance (Ceres style).
+struct HacOptions {
+  /// Bartlett lag window: lags 0…bandwidth of the per-sample scores are summed. −1 = automatic,
+  /// Andrews' (1991) AR(1) plug-in rule on the scores, capped at (samples − 1)/4.
+  int bandwidth = -1;
+  /// Andrews–Monahan (1992) VAR(1) pre-whitening of the scores before the Bartlett window, then
+  /// recolouring: removes most of the kernel's downward bias under strong autocorrelation.
+  bool prewhiten = true;
+};
+
+/// What apply_hac_covariance found.
+struct HacSummary {
+  int bandwidth = 0;          ///< Bartlett lags used
+  double score_lag1 = 0.0;    ///< weighted mean lag-1 autocorrelation of the per-sample scores
+  double median_ratio = 1.0;  ///< median over parameters of std_dev / std_dev_white
+};
+
+/// Replaces the white-noise covariance of `estimate` by the Newey–West (HAC) sandwich
+/// C = m/(m−r) · B·S·B with bread B = (WᵀW)⁻¹ = covariance/σ² (the estimator's own, so the
+/// weighting of WLS and the prior of RLS carry over), and meat S = Σ_|l|≤L (1 − |l|/(L+1))·Γ_l,
+/// Γ_l = Σ_k g_k g_{k−l}ᵀ, where the score g_k = Σ_{i: sample(i)=k} W_iᵀ·e_i sums the n joint rows
+/// of sample k (their residuals are correlated across joints too). With options.prewhiten the
+/// window runs on v_k = g_k − A·g_{k−1} (A the least-squares VAR(1) of the scores, singular
+/// values capped at 0.97) and S = (I − A)⁻¹ S_v (I − A)⁻ᵀ. Keeps the white statistics in
+/// std_dev_white / ci_*_white and refills std_dev, the intervals (same Student-t quantile) and
+/// the poorly-excited list. W (m×p) and e (m) must be the rows the estimator solved (weighted for
+/// WLS); sample (m entries, ≥ 0, non-decreasing) gives the time index of each row, gaps allowed.
+/// Newey & West (1987), Andrews (1991); derivation in docs/methods/estimation.md.
+/// Throws dynid::Error for size mismatches or a decreasing sample index.
+HacSummary apply_hac_covariance(Estimate& estimate, const Eigen::Ref<const Eigen::MatrixXd>& W,
+                                const Eigen::Ref<const Eigen::VectorXd>& e,
+                                const Eigen::Ref<const Eigen::VectorXi>& sample,
+                                const EstimationOptions& estimation_options,
+                                const HacOptions& options = {});
+
 }  // namespace dynid
