@@ -550,10 +550,10 @@ ValidationResult validate_torques(const Model& model, const JointRecord& record,
   out.rows_excluded = m * n - out.rows;
   out.joint_rows_excluded = (static_cast<double>(m) - cnt.array()).round().cast<int>();
   out.rms_all_rows = (e.colwise().squaredNorm().transpose() / static_cast<double>(m)).cwiseSqrt();
-  out.relative_error_all_rows_joint = (e.colwise().squaredNorm().array() /
-                                       r.tau.colwise().squaredNorm().array().max(1e-300))
-                                          .sqrt()
-                                          .transpose();
+  out.relative_error_all_rows_joint =
+      (e.colwise().squaredNorm().array() / r.tau.colwise().squaredNorm().array().max(1e-300))
+          .sqrt()
+          .transpose();
   if (out.rows == 0) {
     throw Error(
         "every sample is below the zero-velocity threshold; the run does not move, or "
