@@ -54,7 +54,7 @@ Eigen::VectorXd resolve_limit(const Eigen::VectorXd& given, const Model& model, 
   return given;
 }
 
-Problem resolve(const Model& model, const ExcitationOptions& o) {
+Problem resolve(const Model& model, const ExcitationOptions& o, double base_seconds = 0.0) {
   Problem p;
   p.n = model.dof();
   const int n = p.n;
@@ -126,6 +126,7 @@ Problem resolve(const Model& model, const ExcitationOptions& o) {
 
   BaseParameterOptions bo;
   bo.layout = o.layout;
+  bo.max_seconds = base_seconds;
   const BaseParameters bp = compute_base_parameters(model, bo);
   p.base = bp.base;
   p.base_names = bp.names;
@@ -294,6 +295,8 @@ class Evaluator {
     worst_.setConstant(-kInf);
     worst_time_.setZero();
     for (int s = 0; s < samples_; ++s) {
+      if (deadline != Clock::time_point::max() && Clock::now() > deadline)
+        throw nlopt::forced_stop();
       q_ = Q_.row(s).transpose();
       dq_ = DQ_.row(s).transpose();
       ddq_ = DDQ_.row(s).transpose();
@@ -361,6 +364,10 @@ class Evaluator {
     return out;
   }
 
+  /// Evaluations past this instant throw nlopt::forced_stop (checked per sample: one evaluation of
+  /// a large tree can take minutes).
+  Clock::time_point deadline = Clock::time_point::max();
+
   Eigen::VectorXd g;      // normalised constraint values, <= 0 holds
   double log_cond = 0.0;  // log κ(W_b)
   double log_det = 0.0;   // log det(W_bᵀW_b)
@@ -388,9 +395,18 @@ int optimisation_samples(const Problem& pb, const ExcitationOptions& o) {
 
 // Fine-grid evaluation with the untightened limits; fills every reported field but the budget.
 ExcitationResult check(const Model& model, const Problem& pb, const ExcitationOptions& o,
-                       const FourierCoefficients& c, int samples) {
+                       const FourierCoefficients& c, int samples,
+                       Clock::time_point deadline = Clock::time_point::max()) {
   Evaluator ev(model, pb, o, samples, false, true);
-  ev.run(c);
+  ev.deadline = deadline;
+  try {
+    ev.run(c);
+  } catch (const nlopt::forced_stop&) {
+    throw Error(
+        "excitation max_time: the final check of the optimised trajectory on the fine "
+        "grid did not finish within another max_time; raise --max-time or lower the "
+        "check samples");
+  }
   ExcitationResult r;
   r.coefficients = c;
   r.criterion = o.criterion;
@@ -513,7 +529,8 @@ ExcitationResult evaluate_excitation(const Model& model, const FourierCoefficien
 
 ExcitationResult optimize_excitation(const Model& model, const ExcitationOptions& options) {
   const auto t_begin = Clock::now();
-  const Problem pb = resolve(model, options);
+  // The base parameters count against the budget too (minutes for a tree of hundreds of links).
+  const Problem pb = resolve(model, options, options.max_time);
   const int samples = optimisation_samples(pb, options);
   Evaluator ev(model, pb, options, samples, true, false);
 
@@ -523,9 +540,10 @@ ExcitationResult optimize_excitation(const Model& model, const ExcitationOptions
   ctx.rest = options.rest_at_ends;
   ctx.d_optimal = options.criterion == ExcitationCriterion::kDOptimality;
   ctx.c = FourierCoefficients::zeros(pb.harmonics, pb.f0);
-  if (options.max_time > 0.0)
-    ctx.deadline = t_begin + std::chrono::duration_cast<Clock::duration>(
-                                 std::chrono::duration<double>(options.max_time));
+  const auto budget =
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.max_time));
+  if (options.max_time > 0.0) ctx.deadline = t_begin + budget;
+  ev.deadline = ctx.deadline;
 
   std::mt19937 rng(options.seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
@@ -618,8 +636,11 @@ ExcitationResult optimize_excitation(const Model& model, const ExcitationOptions
   Evaluator::unpack(pb, ctx.best_x.data(), options.rest_at_ends, c);
   const int check_samples =
       options.check_samples_per_period > 0 ? options.check_samples_per_period : 10 * samples;
-  ExcitationResult r = check(model, pb, options, c, check_samples);
-  const ExcitationResult coarse = check(model, pb, options, c, samples);
+  // The two final checks get one more budget of max_time, so a run ends within about twice it.
+  const Clock::time_point check_deadline =
+      options.max_time > 0.0 ? Clock::now() + budget : Clock::time_point::max();
+  ExcitationResult r = check(model, pb, options, c, check_samples, check_deadline);
+  const ExcitationResult coarse = check(model, pb, options, c, samples, check_deadline);
   r.value = coarse.value;
   r.evaluations = ctx.evaluations;
   r.starts_feasible = starts_feasible;

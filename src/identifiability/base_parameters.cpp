@@ -1,19 +1,63 @@
 #include "dynid/identifiability/base_parameters.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <numeric>
 #include <random>
 #include <sstream>
+#include <utility>
 
 #include <Eigen/QR>
+#include <Eigen/SVD>
 
+#include "dynamics/spatial.hpp"
 #include "dynid/common/error.hpp"
+#include "dynid/dynamics/kinematics.hpp"
 #include "dynid/model/transmission.hpp"
 #include "dynid/regressor/energy_regressor.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
+#include "regressor/joint_columns.hpp"
+#include "regressor/wrench_kernel.hpp"
 
 namespace dynid {
 
 namespace {
+
+// Tree algorithm, scaled units (columns of unit norm): a row of the orthonormal null basis with a
+// residual above kPivotTolerance starts a new pivot; echelon entries below kEntryTolerance are
+// round-off.
+constexpr double kPivotTolerance = 1e-6;
+constexpr double kEntryTolerance = 1e-10;
+
+// States sampled by the tree algorithm: its local systems have at most 28 columns and up to 8 rows
+// per state, so 40 states over-determine them fivefold.
+constexpr int kTreeSamples = 40;
+
+// Largest sampled regressor (plus its orthonormal copy) the dense sweep may allocate [bytes].
+constexpr double kMaxDenseBytes = 2e9;
+
+using Clock = std::chrono::steady_clock;
+
+// Wall-clock limit of one computation (BaseParameterOptions::max_seconds).
+struct Deadline {
+  Clock::time_point end = Clock::time_point::max();
+  double seconds = 0.0;
+  explicit Deadline(double s) : seconds(s) {
+    if (s > 0.0)
+      end = Clock::now() +
+            std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+  }
+  void check() const {
+    if (end != Clock::time_point::max() && Clock::now() > end) {
+      std::ostringstream msg;
+      msg << "base parameters: time limit of " << seconds
+          << " s reached before the computation finished; raise the time limit (--max-time)";
+      throw Error(msg.str());
+    }
+  }
+};
 
 // Random joint value inside the limits, or in [−π, π] (revolute) / [−0.5, 0.5] m (prismatic).
 double random_position(const Joint& joint, std::mt19937& rng) {
@@ -27,7 +71,7 @@ double random_position(const Joint& joint, std::mt19937& rng) {
 }
 
 Eigen::MatrixXd sample_regressor(const Model& model, const BaseParameterOptions& options,
-                                 int samples) {
+                                 int samples, const Deadline& deadline) {
   const int n = model.dof();
   const int p = options.layout.columns(n);
   const std::vector<int> motors = coupled_motors(model);
@@ -48,6 +92,7 @@ Eigen::MatrixXd sample_regressor(const Model& model, const BaseParameterOptions&
   if (options.regressor == BaseRegressor::kTorque) {
     Eigen::MatrixXd W(static_cast<Eigen::Index>(samples) * n, p + extra);
     for (int k = 0; k < samples; ++k) {
+      deadline.check();
       draw();
       torque_regressor(model, ws, options.layout, q, dq, ddq, W.block(k * n, 0, n, p));
       if (extra) coupling_regressor(model, motors, dq, ddq, W.block(k * n, p, n, extra));
@@ -61,6 +106,7 @@ Eigen::MatrixXd sample_regressor(const Model& model, const BaseParameterOptions&
   draw();
   energy_regressor(model, ws, options.layout, q, dq, h0);
   for (int k = 0; k < samples; ++k) {
+    deadline.check();
     draw();
     energy_regressor(model, ws, options.layout, q, dq, h);
     W.row(k) = (h - h0).transpose();
@@ -68,18 +114,375 @@ Eigen::MatrixXd sample_regressor(const Model& model, const BaseParameterOptions&
   return W;
 }
 
-std::string format_coefficient(double k, int digits) {
-  std::ostringstream s;
-  s.precision(digits);
-  s << std::abs(k);
-  return s.str();
+// |k| with `digits` significant digits, as an ostream with that precision writes it (%g); snprintf
+// because expressions of a long chain hold O(n²) coefficients.
+void append_coefficient(std::string& out, double k, int digits) {
+  char buffer[64];
+  const int len = std::snprintf(buffer, sizeof(buffer), "%.*g", digits, std::abs(k));
+  out.append(buffer, static_cast<std::size_t>(std::max(0, len)));
+}
+
+// Snaps K_d and writes the names and expressions of the base parameters.
+void describe(BaseParameters& out, const std::vector<std::string>& names,
+              const BaseParameterOptions& options) {
+  const int r = out.rank;
+  // Coefficients that are zero or integers up to round-off are snapped, so the expressions are
+  // exact where the regrouping rules are exact.
+  for (Eigen::Index i = 0; i < out.K_d.rows(); ++i) {
+    for (Eigen::Index j = 0; j < out.K_d.cols(); ++j) {
+      double& k = out.K_d(i, j);
+      if (std::abs(k) < 1e-9) k = 0.0;
+      if (std::abs(k - std::round(k)) < 1e-9) k = std::round(k);
+    }
+  }
+  // Expressions list the non-zero coefficients of each row; collect them column-wise once (K_d is
+  // mostly zeros for a long chain).
+  std::vector<std::vector<int>> terms(static_cast<std::size_t>(r));
+  for (Eigen::Index j = 0; j < out.K_d.cols(); ++j)
+    for (Eigen::Index i = 0; i < out.K_d.rows(); ++i)
+      if (out.K_d(i, j) != 0.0) terms[i].push_back(static_cast<int>(j));
+  for (int i = 0; i < r; ++i) {
+    const std::string& lead = names[out.base[i]];
+    out.names.push_back(terms[i].empty() ? lead : lead + "R");
+    std::string expr = out.names.back() + " = " + lead;
+    for (int j : terms[i]) {
+      const double k = out.K_d(i, j);
+      expr += k < 0 ? " - " : " + ";
+      if (std::abs(k) != 1.0) {
+        append_coefficient(expr, k, static_cast<int>(options.coefficient_digits));
+        expr += '*';
+      }
+      expr += names[out.dependent[j]];
+    }
+    out.expressions.push_back(std::move(expr));
+  }
+}
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+// What the local systems need of one link at one sampled state: its body regressor (wrench about
+// its origin, moment rows then force rows, linear in its 10 parameters: seed 1 eq. 28), the pose
+// of its frame in its parent's frame, an orthonormal basis of the twists of its strict ancestors
+// carried into its frame, and its joint velocity and acceleration.
+struct LinkSample {
+  Eigen::Matrix<double, 6, kLinkParams> Phi;
+  Eigen::Matrix<double, 6, 6> C;  // first m columns: orthonormal basis of the ancestors' twists
+  int m = 0;
+  Eigen::Matrix3d R;  // frame j in its parent's frame at this q
+  Eigen::Vector3d p;
+  double dq = 0.0, ddq = 0.0;
+};
+
+// A twist (ω; v) of a parent frame, in child frame coordinates: ω' = Rᵀω, v' = Rᵀ(v + ω×p).
+Vector6d to_child(const Eigen::Matrix3d& R, const Eigen::Vector3d& p, const Vector6d& t) {
+  Vector6d out;
+  out.head<3>() = R.transpose() * t.head<3>();
+  out.tail<3>() = R.transpose() * (t.tail<3>() + t.head<3>().cross(p));
+  return out;
+}
+
+// Orthonormal basis of the columns of A (6 × cols), rank decided relative to the largest pivot.
+int orthonormal_basis(const Eigen::Matrix<double, 6, Eigen::Dynamic>& A,
+                      Eigen::Matrix<double, 6, 6>& out) {
+  if (A.cols() == 0) return 0;
+  Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 6, Eigen::Dynamic>> qr(A);
+  qr.setThreshold(1e-12);
+  const int m = static_cast<int>(qr.rank());
+  const Eigen::Matrix<double, 6, 6> Q = qr.householderQ() * Eigen::Matrix<double, 6, 6>::Identity();
+  out.leftCols(m) = Q.leftCols(m);
+  return m;
+}
+
+// Sparse vector over layout columns, sorted by index.
+using Sparse = std::vector<std::pair<int, double>>;
+
+// a - f·b for sorted sparse vectors.
+Sparse axpy(const Sparse& a, double f, const Sparse& b) {
+  Sparse out;
+  out.reserve(a.size() + b.size());
+  std::size_t i = 0, j = 0;
+  while (i < a.size() || j < b.size()) {
+    if (j == b.size() || (i < a.size() && a[i].first < b[j].first)) {
+      out.push_back(a[i++]);
+    } else if (i == a.size() || b[j].first < a[i].first) {
+      out.emplace_back(b[j].first, -f * b[j].second);
+      ++j;
+    } else {
+      out.emplace_back(a[i].first, a[i].second - f * b[j].second);
+      ++i;
+      ++j;
+    }
+  }
+  return out;
+}
+
+// Numerical base parameters exploiting the tree (docs/methods/model.md, "Base parameters of large
+// trees"). A column combination x has no effect (W·x = 0) iff it moves no joint torque at any
+// state. The columns of link k are non-zero only in the rows of k and its ancestors, and every
+// ancestor row is the pairing of that ancestor's twist with the wrench the subtree exerts at k's
+// parent a, so the rows of the strict ancestors of a can be replaced, state by state, by an
+// orthonormal basis of their twists in frame a (≤ 6 rows) without changing which x have no effect.
+// The null space of each such local system over (link k, link a, their joint columns) is computed
+// by an SVD; their union spans the null space of W (regrouping moves parameters from a link to its
+// parent; checked against the dense sweep in tests/identifiability). The dependent columns are the
+// last non-zero indices of an echelon basis of that null space, exactly the columns the
+// left-to-right sweep finds dependent, and back-substitution gives K_d.
+BaseParameters tree_base_parameters(const Model& model, const BaseParameterOptions& options,
+                                    int samples, const std::vector<std::string>& names,
+                                    const Deadline& deadline) {
+  const int n = model.dof();
+  const int jc = options.layout.joint_columns();
+  const int p = options.layout.columns(n);
+  auto link_col = [](int j, int i) { return kLinkParams * j + i; };
+  auto joint_col = [&](int j, int c) { return kLinkParams * n + jc * j + c; };
+
+  // 1. Sampled states: per-link quantities only, O(n) per state.
+  std::vector<LinkSample> data(static_cast<std::size_t>(samples) * n);
+  {
+    Workspace ws(model);
+    std::mt19937 rng(options.seed);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    Eigen::VectorXd q(n), dq(n), ddq(n);
+    detail::WrenchBlocks b;
+    Eigen::Matrix<double, 6, Eigen::Dynamic> A(6, 7);
+    for (int s = 0; s < samples; ++s) {
+      deadline.check();
+      for (int j = 0; j < n; ++j) {
+        q[j] = random_position(model.joints[j], rng);
+        dq[j] = u(rng);
+        ddq[j] = u(rng);
+      }
+      forward_kinematics(model, ws, q, dq, ddq, true);
+      for (int j = 0; j < n; ++j) {
+        const LinkState& st = ws.links[j];
+        LinkSample& d = data[static_cast<std::size_t>(s) * n + j];
+        detail::wrench_blocks(st.w, st.dw, st.a, b);
+        d.Phi.setZero();
+        d.Phi.block<3, 6>(0, 0) = b.L_I;
+        d.Phi.block<3, 3>(0, 6) = b.A_skew;
+        d.Phi.block<3, 3>(3, 6) = b.K_mc;
+        d.Phi.block<3, 1>(3, 9) = b.a;
+        d.R = st.R_PJ;
+        d.p = st.p_PJ;
+        d.dq = dq[j];
+        d.ddq = ddq[j];
+        const int a = model.joints[j].parent;
+        if (a < 0) {
+          d.m = 0;
+          continue;
+        }
+        // Ancestors of j = parent a and the ancestors of a, carried into frame j.
+        const LinkSample& pa = data[static_cast<std::size_t>(s) * n + a];
+        A.resize(6, pa.m + 1);
+        for (int c = 0; c < pa.m; ++c) A.col(c) = to_child(d.R, d.p, pa.C.col(c));
+        A.col(pa.m) = to_child(d.R, d.p, detail::joint_twist(model.joints[a]));
+        d.m = orthonormal_basis(A, d.C);
+      }
+    }
+  }
+
+  // 2. Local systems. System k: columns [link k | link a | joint k | joint a] (a = parent of k,
+  // absent for a root joint); rows per state: joint k, joint a, the ancestors' basis of a.
+  auto system = [&](int k, Eigen::MatrixXd& M, std::vector<int>& cols) {
+    const int a = model.joints[k].parent;
+    cols.clear();
+    for (int i = 0; i < kLinkParams; ++i) cols.push_back(link_col(k, i));
+    if (a >= 0)
+      for (int i = 0; i < kLinkParams; ++i) cols.push_back(link_col(a, i));
+    for (int c = 0; c < jc; ++c) cols.push_back(joint_col(k, c));
+    if (a >= 0)
+      for (int c = 0; c < jc; ++c) cols.push_back(joint_col(a, c));
+    const int width = static_cast<int>(cols.size());
+    const int rows_per = a < 0 ? 1 : 2 + 6;
+    M.setZero(static_cast<Eigen::Index>(samples) * rows_per, width);
+    const int off_a = kLinkParams, off_jk = a < 0 ? kLinkParams : 2 * kLinkParams,
+              off_ja = off_jk + jc;
+    const Vector6d s_k = detail::joint_twist(model.joints[k]);
+    const Vector6d s_a = a < 0 ? Vector6d::Zero() : detail::joint_twist(model.joints[a]);
+    Eigen::Index r = 0;
+    for (int s = 0; s < samples; ++s) {
+      const LinkSample& dk = data[static_cast<std::size_t>(s) * n + k];
+      M.block(r, 0, 1, kLinkParams) = s_k.transpose() * dk.Phi;
+      if (jc) detail::joint_columns(options.layout, dk.dq, dk.ddq, M.row(r).segment(off_jk, jc));
+      ++r;
+      if (a < 0) continue;
+      const LinkSample& da = data[static_cast<std::size_t>(s) * n + a];
+      M.block(r, 0, 1, kLinkParams) = to_child(dk.R, dk.p, s_a).transpose() * dk.Phi;
+      M.block(r, off_a, 1, kLinkParams) = s_a.transpose() * da.Phi;
+      if (jc) detail::joint_columns(options.layout, da.dq, da.ddq, M.row(r).segment(off_ja, jc));
+      ++r;
+      for (int c = 0; c < da.m; ++c, ++r) {
+        M.block(r, 0, 1, kLinkParams) = to_child(dk.R, dk.p, da.C.col(c)).transpose() * dk.Phi;
+        M.block(r, off_a, 1, kLinkParams) = da.C.col(c).transpose() * da.Phi;
+      }
+      r += 6 - da.m;  // unused rows stay zero
+    }
+  };
+
+  // Column norms, each in the system where the column is "at home" (all its non-zero rows).
+  Eigen::VectorXd norms = Eigen::VectorXd::Zero(p);
+  Eigen::MatrixXd M;
+  std::vector<int> cols;
+  for (int k = 0; k < n; ++k) {
+    deadline.check();
+    system(k, M, cols);
+    for (int i = 0; i < kLinkParams; ++i) norms[cols[i]] = M.col(i).norm();
+    const int off_jk = model.joints[k].parent < 0 ? kLinkParams : 2 * kLinkParams;
+    for (int c = 0; c < jc; ++c) norms[cols[off_jk + c]] = M.col(off_jk + c).norm();
+  }
+  const double largest = norms.size() ? norms.maxCoeff() : 0.0;
+  std::vector<bool> zero(static_cast<std::size_t>(p));
+  for (int c = 0; c < p; ++c) zero[c] = !(norms[c] > options.zero_tolerance * largest);
+
+  // 3. Echelon basis of the null space by last non-zero index (= the left-to-right sweep).
+  std::vector<Sparse> pivot(static_cast<std::size_t>(p));
+  std::vector<bool> has_pivot(static_cast<std::size_t>(p), false);
+  // Significance of an entry: its size in the units of columns scaled to unit norm.
+  auto insert = [&](Sparse v) {
+    double scale = 0.0;
+    for (const auto& e : v) scale = std::max(scale, std::abs(e.second) * norms[e.first]);
+    const double drop = 1e-9 * scale;
+    while (true) {
+      v.erase(std::remove_if(v.begin(), v.end(),
+                             [&](const std::pair<int, double>& e) {
+                               return !(std::abs(e.second) * norms[e.first] > drop);
+                             }),
+              v.end());
+      if (v.empty()) return;
+      const int c = v.back().first;
+      if (!has_pivot[c]) {
+        const double lead = v.back().second;
+        for (auto& e : v) e.second /= lead;
+        pivot[c] = std::move(v);
+        has_pivot[c] = true;
+        return;
+      }
+      v = axpy(v, v.back().second, pivot[c]);
+    }
+  };
+  for (int c = 0; c < p; ++c) {
+    if (!zero[c]) continue;
+    pivot[c] = {{c, 1.0}};
+    has_pivot[c] = true;
+  }
+  for (int link = 0; link < n; ++link) {
+    deadline.check();
+    system(link, M, cols);
+    std::vector<int> live;  // non-zero columns of the system, scaled to unit norm
+    for (int i = 0; i < static_cast<int>(cols.size()); ++i)
+      if (!zero[cols[i]]) live.push_back(i);
+    if (live.empty()) continue;
+    Eigen::MatrixXd A(M.rows(), static_cast<Eigen::Index>(live.size()));
+    Eigen::VectorXd scale(static_cast<Eigen::Index>(live.size()));
+    for (std::size_t i = 0; i < live.size(); ++i) {
+      scale[i] = M.col(live[i]).norm();
+      A.col(i) = M.col(live[i]) / scale[i];
+    }
+    // R of a QR first: the SVD then works on a small square matrix.
+    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(A);
+    const Eigen::Index w = A.cols(), h = std::min(A.rows(), w);
+    const Eigen::MatrixXd Rm = qr.matrixQR().topRows(h).triangularView<Eigen::Upper>();
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Rm, Eigen::ComputeFullV);
+    const Eigen::VectorXd sv = svd.singularValues();
+    std::vector<Eigen::Index> null_cols;
+    for (Eigen::Index i = 0; i < w; ++i)
+      if (!((i < sv.size() ? sv[i] : 0.0) > options.dependence_tolerance)) null_cols.push_back(i);
+    if (null_cols.empty()) continue;
+    const auto m = static_cast<Eigen::Index>(null_cols.size());
+    Eigen::MatrixXd N(w, m);  // orthonormal basis of the local null space, scaled columns
+    for (Eigen::Index i = 0; i < m; ++i) N.col(i) = svd.matrixV().col(null_cols[i]);
+    // Echelon form by last index, computed stably: scanning the columns from the highest global
+    // index down, a column is a pivot when its row of N is independent of the pivot rows found so
+    // far (residual > kPivotTolerance; rows of N have norm <= 1). Then X = N·N_P⁻¹ holds one null
+    // vector per pivot, 1 there and 0 at the other pivots, non-zero elsewhere only below it.
+    std::vector<Eigen::Index> order(static_cast<std::size_t>(w));
+    std::iota(order.begin(), order.end(), Eigen::Index{0});
+    std::sort(order.begin(), order.end(),
+              [&](Eigen::Index x, Eigen::Index y) { return cols[live[x]] > cols[live[y]]; });
+    Eigen::MatrixXd Qr(m, m);
+    std::vector<Eigen::Index> piv;
+    for (Eigen::Index i : order) {
+      if (static_cast<Eigen::Index>(piv.size()) == m) break;
+      Eigen::VectorXd r = N.row(i).transpose();
+      for (int pass = 0; pass < 2; ++pass)
+        for (std::size_t k = 0; k < piv.size(); ++k) r -= Qr.col(k).dot(r) * Qr.col(k);
+      if (r.norm() > kPivotTolerance) {
+        Qr.col(static_cast<Eigen::Index>(piv.size())) = r / r.norm();
+        piv.push_back(i);
+      }
+    }
+    Eigen::MatrixXd NP(static_cast<Eigen::Index>(piv.size()), m);
+    for (std::size_t k = 0; k < piv.size(); ++k) NP.row(k) = N.row(piv[k]);
+    const Eigen::MatrixXd X = N * NP.completeOrthogonalDecomposition().pseudoInverse();
+    for (std::size_t t = 0; t < piv.size(); ++t) {
+      const int pivot_col = cols[live[piv[t]]];
+      // Null vectors of the parent alone (pivot among its parameters) come from its own system.
+      if (pivot_col < kLinkParams * n && pivot_col / kLinkParams != link) continue;
+      Sparse v;
+      const auto tc = static_cast<Eigen::Index>(t);
+      const double lead = X(piv[t], tc) / scale[piv[t]];
+      for (Eigen::Index c = 0; c < w; ++c) {
+        const double x = X(c, tc);
+        if (std::abs(x) > kEntryTolerance) v.emplace_back(cols[live[c]], x / scale[c] / lead);
+      }
+      std::sort(v.begin(), v.end());
+      insert(std::move(v));
+    }
+  }
+
+  // 4. Base, dependent and unidentifiable columns; K_d by back-substitution.
+  BaseParameters out;
+  out.layout_names = names;
+  std::vector<int> base_pos(static_cast<std::size_t>(p), -1);
+  for (int c = 0; c < p; ++c) {
+    if (zero[c]) {
+      out.unidentifiable.push_back(c);
+    } else if (has_pivot[c]) {
+      out.dependent.push_back(c);
+    } else {
+      base_pos[c] = static_cast<int>(out.base.size());
+      out.base.push_back(c);
+    }
+  }
+  out.rank = static_cast<int>(out.base.size());
+  if (out.rank == 0)
+    throw Error("no parameter of the model has any effect on the sampled regressor");
+  out.K_d = Eigen::MatrixXd::Zero(out.rank, static_cast<Eigen::Index>(out.dependent.size()));
+  for (std::size_t j = 0; j < out.dependent.size(); ++j) {
+    deadline.check();
+    const int d = out.dependent[j];
+    Sparse v = pivot[d];
+    // Earlier dependent entries are replaced by their reduced vectors (base columns only, plus
+    // their own), from the last one down: a replacement adds base columns only.
+    int bound = d;
+    while (true) {
+      int at = -1;
+      for (std::size_t e = v.size(); e-- > 0;) {
+        const int c = v[e].first;
+        if (c < bound && has_pivot[c] && v[e].second != 0.0) {
+          at = static_cast<int>(e);
+          break;
+        }
+      }
+      if (at < 0) break;
+      bound = v[at].first;
+      v = axpy(v, v[at].second, pivot[bound]);
+    }
+    for (const auto& [c, x] : v)
+      if (base_pos[c] >= 0) out.K_d(base_pos[c], static_cast<Eigen::Index>(j)) = -x;
+    pivot[d] = std::move(v);  // reduced: later columns may refer to it
+  }
+  describe(out, names, options);
+  return out;
 }
 
 }  // namespace
 
-BaseParameters classify_columns(const Eigen::Ref<const Eigen::MatrixXd>& W,
-                                const std::vector<std::string>& names,
-                                const BaseParameterOptions& options) {
+namespace {
+
+BaseParameters classify_dense(const Eigen::Ref<const Eigen::MatrixXd>& W,
+                              const std::vector<std::string>& names,
+                              const BaseParameterOptions& options, const Deadline& deadline) {
   const Eigen::Index p = W.cols();
   if (static_cast<Eigen::Index>(names.size()) != p) {
     throw Error("classify_columns: " + std::to_string(names.size()) + " names for " +
@@ -94,6 +497,7 @@ BaseParameters classify_columns(const Eigen::Ref<const Eigen::MatrixXd>& W,
   Eigen::MatrixXd Q(W.rows(), p);
   int r = 0;
   for (Eigen::Index c = 0; c < p; ++c) {
+    if (c % 64 == 0) deadline.check();
     if (!(norms[c] > options.zero_tolerance * largest)) {
       out.unidentifiable.push_back(static_cast<int>(c));
       continue;
@@ -115,43 +519,58 @@ BaseParameters classify_columns(const Eigen::Ref<const Eigen::MatrixXd>& W,
   for (int k = 0; k < r; ++k) W1.col(k) = W.col(out.base[k]);
   for (size_t k = 0; k < out.dependent.size(); ++k) W2.col(k) = W.col(out.dependent[k]);
   out.K_d = W2.cols() ? Eigen::MatrixXd(W1.colPivHouseholderQr().solve(W2)) : Eigen::MatrixXd(r, 0);
-  // Coefficients that are zero or integers up to round-off are snapped, so the expressions are
-  // exact where the regrouping rules are exact.
-  for (Eigen::Index i = 0; i < out.K_d.rows(); ++i) {
-    for (Eigen::Index j = 0; j < out.K_d.cols(); ++j) {
-      double& k = out.K_d(i, j);
-      if (std::abs(k) < 1e-9) k = 0.0;
-      if (std::abs(k - std::round(k)) < 1e-9) k = std::round(k);
-    }
-  }
-  for (int i = 0; i < r; ++i) {
-    const std::string& lead = names[out.base[i]];
-    std::ostringstream expr;
-    bool regrouped = false;
-    for (size_t j = 0; j < out.dependent.size(); ++j) {
-      const double k = out.K_d(i, j);
-      if (k == 0.0) continue;
-      regrouped = true;
-      expr << (k < 0 ? " - " : " + ");
-      if (std::abs(k) != 1.0) expr << format_coefficient(k, options.coefficient_digits) << "*";
-      expr << names[out.dependent[j]];
-    }
-    out.names.push_back(regrouped ? lead + "R" : lead);
-    out.expressions.push_back(out.names.back() + " = " + lead + expr.str());
-  }
+  describe(out, names, options);
   return out;
 }
 
+}  // namespace
+
+BaseParameters classify_columns(const Eigen::Ref<const Eigen::MatrixXd>& W,
+                                const std::vector<std::string>& names,
+                                const BaseParameterOptions& options) {
+  return classify_dense(W, names, options, Deadline(options.max_seconds));
+}
+
 BaseParameters compute_base_parameters(const Model& model, const BaseParameterOptions& options) {
+  const Deadline deadline(options.max_seconds);
   const int n = model.dof();
   const int p = options.layout.columns(n);
+  std::vector<std::string> names = options.layout.names(n);
+  const bool coupled = options.coupling && options.regressor == BaseRegressor::kTorque &&
+                       !coupled_motors(model).empty();
+  bool tree = options.algorithm == BaseAlgorithm::kTree;
+  if (options.algorithm == BaseAlgorithm::kAuto)
+    tree = options.regressor == BaseRegressor::kTorque && !coupled;
+  if (tree && (options.regressor != BaseRegressor::kTorque || coupled)) {
+    throw Error(
+        "base parameters: the tree algorithm handles the torque regressor without coupled "
+        "motors only; use BaseAlgorithm::kDense");
+  }
+  if (tree) {
+    const int samples = options.samples > 0 ? options.samples : kTreeSamples;
+    BaseParameters out = tree_base_parameters(model, options, samples, names, deadline);
+    out.samples = samples;
+    out.algorithm = BaseAlgorithm::kTree;
+    return out;
+  }
   const int samples =
       options.samples > 0 ? options.samples : std::max(100, 4 * p / std::max(1, n) + 50);
-  std::vector<std::string> names = options.layout.names(n);
   if (options.coupling && options.regressor == BaseRegressor::kTorque) {
     for (const auto& name : coupling_column_names(model)) names.push_back(name);
   }
-  BaseParameters out = classify_columns(sample_regressor(model, options, samples), names, options);
+  // The dense sweep holds the whole sampled regressor: refuse what would not fit rather than fail
+  // inside the allocator.
+  const double rows = options.regressor == BaseRegressor::kTorque ? double(samples) * n : samples;
+  const double bytes = 2.0 * 8.0 * rows * static_cast<double>(names.size());
+  if (bytes > kMaxDenseBytes) {
+    std::ostringstream msg;
+    msg << "base parameters: the dense computation for " << n << " joints needs about "
+        << std::lround(bytes / 1e9) << " GB (limit " << kMaxDenseBytes / 1e9
+        << " GB); use the torque regressor without coupled motors (tree algorithm)";
+    throw Error(msg.str());
+  }
+  BaseParameters out =
+      classify_dense(sample_regressor(model, options, samples, deadline), names, options, deadline);
   out.samples = samples;
   return out;
 }

@@ -1,9 +1,11 @@
 #include "dynid/io/csv_chunk_reader.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
 #include "dynid/common/error.hpp"
+#include "dynid/io/csv_reader.hpp"
 #include "io/csv_parse.hpp"
 
 namespace dynid {
@@ -16,6 +18,7 @@ struct CsvChunkReader::Impl {
   std::size_t pos = 0;     // start of unread text in buffer
   std::size_t filled = 0;  // end of valid text in buffer
   bool eof = false;
+  char eol = '\n';  // line terminator, detected from the first buffer (csv_detail::detect_eol)
   long line = 0;
   Eigen::Index rows = 0;
   std::vector<std::string> columns;
@@ -30,7 +33,12 @@ struct CsvChunkReader::Impl {
     while (true) {
       char* start = buffer.data() + pos;
       const std::size_t avail = filled - pos;
-      char* nl = static_cast<char*>(std::memchr(start, '\n', avail));
+      char* nl = static_cast<char*>(std::memchr(start, eol, avail));
+      if (static_cast<std::size_t>(
+              (nl != nullptr ? nl - start : static_cast<std::ptrdiff_t>(avail))) >
+          kMaxCsvLineBytes) {
+        csv_detail::throw_long_line(source, line + 1);
+      }
       if (nl != nullptr) {
         b = start;
         e = csv_detail::strip_cr(b, nl);
@@ -52,7 +60,7 @@ struct CsvChunkReader::Impl {
       std::memmove(buffer.data(), start, avail);
       pos = 0;
       filled = avail;
-      if (filled == buffer.size()) buffer.resize(buffer.size() * 2);
+      if (filled == buffer.size()) buffer.resize(std::min(buffer.size() * 2, kMaxCsvLineBytes + 2));
       const std::size_t got = std::fread(buffer.data() + filled, 1, buffer.size() - filled, file);
       filled += got;
       if (got == 0) {
@@ -79,6 +87,17 @@ CsvChunkReader::CsvChunkReader(const std::string& path, const CsvChunkOptions& o
     throw Error(path + ": cannot open (" + std::strerror(errno) +
                 "); check the path given to --in");
   }
+  // First read: skip a byte-order mark and learn the line terminator.
+  Impl& s = *impl_;
+  s.filled = std::fread(s.buffer.data(), 1, s.buffer.size(), s.file);
+  if (s.filled < s.buffer.size()) {
+    if (std::ferror(s.file)) {
+      throw Error(path + ": read error (" + std::strerror(errno) + "); check the file");
+    }
+    s.eof = true;
+  }
+  s.pos = csv_detail::bom_length(s.buffer.data(), s.buffer.data() + s.filled);
+  s.eol = csv_detail::detect_eol(s.buffer.data() + s.pos, s.buffer.data() + s.filled);
   const char* b = nullptr;
   const char* e = nullptr;
   bool terminated = true;

@@ -9,6 +9,7 @@
 #include <fast_float/fast_float.h>
 
 #include "dynid/common/error.hpp"
+#include "dynid/io/csv_reader.hpp"
 
 namespace dynid::csv_detail {
 namespace {
@@ -50,6 +51,21 @@ const char* parse_number(const char* p, const char* e, double& value) {
 
 }  // namespace
 
+char detect_eol(const char* b, const char* e) {
+  for (const char* p = b; p < e; ++p) {
+    if (*p == '\n') return '\n';
+    if (*p == '\r') return (p + 1 < e && p[1] == '\n') ? '\n' : '\r';
+  }
+  return '\n';
+}
+
+void throw_long_line(const std::string& source, long line) {
+  throw Error(where(source, line) + "line is longer than " +
+              std::to_string(kMaxCsvLineBytes >> 20) +
+              " MiB (the limit of one CSV line); check that the file is a CSV with one sample per "
+              "line");
+}
+
 bool is_skippable(const char* b, const char* e) {
   const char* p = skip_spaces(b, e);
   return p == e || *p == '#';
@@ -81,6 +97,11 @@ std::vector<std::string> parse_header(const char* b, const char* e, const std::s
     names.emplace_back(fb, fe);
     if (comma == e) break;
     p = comma + 1;
+  }
+  if (names.size() > kMaxCsvColumns) {
+    throw Error(where(source, line) + "header has " + std::to_string(names.size()) +
+                " columns, more than the limit of " + std::to_string(kMaxCsvColumns) +
+                "; split the file");
   }
   if (all_numeric) {
     throw Error(where(source, line) +

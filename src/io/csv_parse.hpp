@@ -9,6 +9,18 @@
 
 namespace dynid::csv_detail {
 
+/// Length of a UTF-8 byte-order mark at the start of [b, e), else 0.
+inline std::size_t bom_length(const char* b, const char* e) {
+  return (e - b >= 3 && b[0] == '\xEF' && b[1] == '\xBB' && b[2] == '\xBF') ? 3 : 0;
+}
+
+/// The line terminator of a text whose start is [b, e): '\r' when its first line end is a CR not
+/// followed by LF (classic Mac files), else '\n' (LF and CRLF files).
+char detect_eol(const char* b, const char* e);
+
+/// Throws the error for a line longer than kMaxCsvLineBytes; `line` is 1-based.
+[[noreturn]] void throw_long_line(const std::string& source, long line);
+
 /// Removes a trailing '\r' (CRLF files) from [b, e).
 inline const char* strip_cr(const char* b, const char* e) {
   return (e > b && e[-1] == '\r') ? e - 1 : e;

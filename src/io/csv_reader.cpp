@@ -6,31 +6,53 @@
 #include <cstring>
 #include <memory>
 
+#include <sys/stat.h>
+
 #include "dynid/common/error.hpp"
 #include "io/csv_parse.hpp"
 
 namespace dynid {
 namespace {
 
+// Whole file, read with a cap (kMaxCsvFileBytes) and a line-length check as it arrives, so that
+// a device or pipe without line ends (/dev/zero) ends in an error after one line's worth of bytes.
 std::string read_whole_file(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+    throw Error(path + ": is a directory; give the path of a CSV file to --in");
+  }
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
                                                        &std::fclose);
   if (!file) {
     throw Error(path + ": cannot open (" + std::strerror(errno) +
                 "); check the path given to --in");
   }
+  auto too_large = [&]() {
+    throw Error(path + ": larger than " + std::to_string(kMaxCsvFileBytes >> 20) +
+                " MiB, the limit for reading a CSV file into memory; use --stream where the "
+                "command offers it, or split the file");
+  };
   std::string text;
-  if (std::fseek(file.get(), 0, SEEK_END) == 0) {
-    const long size = std::ftell(file.get());
-    std::rewind(file.get());
-    if (size > 0) {  // regular file: one read into place
-      text.resize(static_cast<std::size_t>(size));
-      text.resize(std::fread(text.data(), 1, text.size(), file.get()));
+  if (S_ISREG(st.st_mode)) {
+    if (static_cast<std::size_t>(st.st_size) > kMaxCsvFileBytes) too_large();
+    text.reserve(static_cast<std::size_t>(st.st_size));
+  }
+  std::size_t line_start = 0;  // offset just after the last line end seen
+  char buffer[1 << 16];
+  std::size_t got = 0;
+  while ((got = std::fread(buffer, 1, sizeof(buffer), file.get())) > 0) {
+    if (text.size() + got > kMaxCsvFileBytes) too_large();
+    const std::size_t before = text.size();
+    text.append(buffer, got);
+    const void* lf = ::memrchr(text.data() + before, '\n', got);
+    const void* cr = ::memrchr(text.data() + before, '\r', got);
+    const char* last = std::max(static_cast<const char*>(lf), static_cast<const char*>(cr));
+    if (last != nullptr) line_start = static_cast<std::size_t>(last - text.data()) + 1;
+    if (text.size() - line_start > kMaxCsvLineBytes) {
+      const long line = 1 + static_cast<long>(std::count(text.begin(), text.end(), '\n'));
+      csv_detail::throw_long_line(path, line);
     }
   }
-  char buffer[1 << 16];  // anything left (pipes, files that grew)
-  std::size_t got = 0;
-  while ((got = std::fread(buffer, 1, sizeof(buffer), file.get())) > 0) text.append(buffer, got);
   if (std::ferror(file.get())) {
     throw Error(path + ": read error (" + std::strerror(errno) + "); check the file");
   }
@@ -59,8 +81,9 @@ CsvTable parse_csv_text(std::string_view text, const std::string& source, bool h
   using namespace csv_detail;
   CsvTable table;
   table.source = source;
-  const char* p = text.data();
-  const char* const end = p + text.size();
+  const char* const end = text.data() + text.size();
+  const char* p = text.data() + bom_length(text.data(), end);
+  const char eol = detect_eol(p, end);
   long line = 0;
   // Next line as [b, e) without its CR/LF; false at the end of the text.
   const char* b = nullptr;
@@ -69,9 +92,11 @@ CsvTable parse_csv_text(std::string_view text, const std::string& source, bool h
   auto next_line = [&]() {
     if (p >= end) return false;
     const char* nl =
-        static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(end - p)));
+        static_cast<const char*>(std::memchr(p, eol, static_cast<std::size_t>(end - p)));
     b = p;
     terminated = nl != nullptr;
+    if (static_cast<std::size_t>((terminated ? nl : end) - b) > kMaxCsvLineBytes)
+      throw_long_line(source, line + 1);
     e = strip_cr(b, terminated ? nl : end);
     p = terminated ? nl + 1 : end;
     ++line;
@@ -102,10 +127,15 @@ CsvTable parse_csv_text(std::string_view text, const std::string& source, bool h
   Eigen::Index capacity = 1;
   for (const char* q = p; q < end;) {
     const char* nl =
-        static_cast<const char*>(std::memchr(q, '\n', static_cast<std::size_t>(end - q)));
+        static_cast<const char*>(std::memchr(q, eol, static_cast<std::size_t>(end - q)));
     ++capacity;
     if (nl == nullptr) break;
     q = nl + 1;
+  }
+  if (capacity > kMaxCsvRows + 1) {
+    throw Error(source + ": more than " + std::to_string(kMaxCsvRows) +
+                " lines, the limit for reading a CSV file into memory; use --stream where the "
+                "command offers it, or split the file");
   }
   // Rows are parsed into contiguous row-major storage (sequential writes), then transposed once.
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> buffer(capacity, n);

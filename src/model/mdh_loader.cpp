@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <map>
 #include <set>
 #include <sstream>
 #include <string>
@@ -13,6 +14,7 @@
 
 #include "dynid/common/error.hpp"
 #include "dynid/model/urdf_loader.hpp"
+#include "model/printable.hpp"
 
 namespace dynid {
 
@@ -30,6 +32,8 @@ Joint mdh_joint(const MdhRow& row) {
 }
 
 namespace {
+
+using model_detail::printable;
 
 /// Context for one-line error messages: "<source>: <where>: <problem>; <fix>".
 struct Ctx {
@@ -101,9 +105,11 @@ double as_number(const YAML::Node& node, const Ctx& ctx, const std::string& wher
   if (!node.IsScalar()) ctx.fail(where, "must be a number; give a single finite value");
   double v = 0.0;
   if (!parse_number(node.Scalar(), v)) {
-    ctx.fail(where, "'" + node.Scalar() + "' is not a number; give a finite value (or k*pi/m)");
+    ctx.fail(where, "'" + printable(node.Scalar(), 40) +
+                        "' is not a number; give a finite value (or k*pi/m)");
   }
-  if (!std::isfinite(v)) ctx.fail(where, "is " + node.Scalar() + "; give a finite value");
+  if (!std::isfinite(v))
+    ctx.fail(where, "is " + printable(node.Scalar(), 40) + "; give a finite value");
   return v;
 }
 
@@ -148,7 +154,7 @@ void check_keys(const YAML::Node& map, const std::set<std::string>& allowed, con
     if (!allowed.count(key)) {
       std::string list;
       for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      ctx.fail(where, "unknown key '" + key + "'; allowed keys are " + list);
+      ctx.fail(where, "unknown key '" + printable(key, 40) + "'; allowed keys are " + list);
     }
   }
 }
@@ -223,7 +229,7 @@ JointLimits read_limits(const YAML::Node& n, const Ctx& ctx, const std::string& 
 std::string row_where(int k, const YAML::Node& row) {
   std::string w = "joints[" + std::to_string(k + 1) + "]";
   if (row.IsMap() && row["name"].IsDefined() && row["name"].IsScalar()) {
-    w += " ('" + row["name"].Scalar() + "')";
+    w += " ('" + printable(row["name"].Scalar(), 40) + "')";
   }
   return w;
 }
@@ -233,6 +239,11 @@ void read_mdh_table(const YAML::Node& doc, const Ctx& ctx, Model& model) {
   if (!rows.IsSequence() || rows.size() == 0) {
     ctx.fail("joints", "must be a non-empty list of MDH rows");
   }
+  if (rows.size() > static_cast<std::size_t>(kMaxJoints)) {
+    ctx.fail("joints", "has " + std::to_string(rows.size()) + " rows; dynid handles at most " +
+                           std::to_string(kMaxJoints) + " joints");
+  }
+  std::map<std::string, std::size_t> row_of_name;
   Joint base_pose;  // R_PJ, p_PJ of the base placement
   if (has(doc, "base")) {
     const YAML::Node b = doc["base"];
@@ -271,6 +282,11 @@ void read_mdh_table(const YAML::Node& doc, const Ctx& ctx, Model& model) {
     }
     Joint j = mdh_joint(mdh);
     j.name = has(row, "name") ? row["name"].as<std::string>() : "joint" + std::to_string(k + 1);
+    const auto [seen, fresh] = row_of_name.emplace(j.name, k);
+    if (!fresh) {
+      ctx.fail(where + ".name", "repeats the name of joints[" + std::to_string(seen->second + 1) +
+                                    "]; give every joint a unique name");
+    }
     j.link_name = has(row, "link") ? row["link"].as<std::string>() : "link" + std::to_string(k + 1);
     const double parent = opt(row, "parent", static_cast<double>(k), ctx, where);
     if (parent != std::floor(parent) || parent < 0.0 || parent > static_cast<double>(k)) {
@@ -338,8 +354,9 @@ Model parse_yaml_model(const std::string& yaml, const std::string& source,
   try {
     doc = YAML::Load(yaml);
   } catch (const YAML::Exception& e) {
-    throw Error("robot file '" + source + "' is not valid YAML (line " +
-                std::to_string(e.mark.line + 1) + ": " + e.msg + "); fix the syntax");
+    throw Error("robot file '" + source + "', line " + std::to_string(e.mark.line + 1) +
+                ", column " + std::to_string(e.mark.column + 1) + ": not valid YAML (" +
+                printable(e.msg) + "); fix the syntax");
   }
   if (!doc.IsMap()) ctx.fail("", "the top level must be a map with 'joints:' or 'urdf:'");
   const bool mdh = has(doc, "joints");
@@ -382,8 +399,10 @@ Model parse_yaml_model(const std::string& yaml, const std::string& source,
     if (has(doc, "gravity")) model.gravity = vec(doc["gravity"], 3, ctx, "gravity");
     read_transmission(doc, ctx, model);
   } catch (const YAML::Exception& e) {
-    throw Error("robot file '" + source + "' (line " + std::to_string(e.mark.line + 1) +
-                "): " + e.msg + "; check the value's type");
+    const std::string line =
+        e.mark.is_null() ? std::string() : ", line " + std::to_string(e.mark.line + 1);
+    throw Error("robot file '" + source + "'" + line + ": " + printable(e.msg) +
+                "; check the value's type");
   }
   model.source = source;
   model.finalize();

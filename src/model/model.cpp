@@ -1,9 +1,12 @@
 #include "dynid/model/model.hpp"
 
 #include <cmath>
+#include <numeric>
 #include <sstream>
+#include <unordered_map>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 
 #include "dynid/common/error.hpp"
 
@@ -85,17 +88,74 @@ void check_physical(const LinkParams& p, const std::string& link) {
   }
 }
 
+// Relative threshold of the invertibility test: smallest / largest pivot magnitude.
+constexpr double kSingularRatio = 1e-12;
+
+// True when N is invertible by a scale-invariant test: N = 0.001·I passes, a matrix with a row
+// that is a multiple of another fails whatever its scale. A diagonal N (the common case: gear
+// ratios or the identity) is checked in O(n²) without any factorisation; otherwise the coupled
+// joints form independent blocks (connected components of the non-zero pattern), each tested by a
+// rank-revealing column-pivoted QR, |R_kk| > kSingularRatio·|R_11|.
+bool transmission_invertible(const Eigen::MatrixXd& N) {
+  const Eigen::Index n = N.rows();
+  std::vector<Eigen::Index> root(static_cast<std::size_t>(n));
+  std::iota(root.begin(), root.end(), Eigen::Index{0});
+  auto find = [&](Eigen::Index i) {
+    while (root[i] != i) i = root[i] = root[root[i]];
+    return i;
+  };
+  bool diagonal = true;
+  for (Eigen::Index c = 0; c < n; ++c) {
+    for (Eigen::Index r = 0; r < n; ++r) {
+      if (r == c || N(r, c) == 0.0) continue;
+      diagonal = false;
+      root[find(r)] = find(c);
+    }
+  }
+  if (diagonal) {
+    const Eigen::ArrayXd d = N.diagonal().cwiseAbs();
+    return d.minCoeff() > kSingularRatio * d.maxCoeff();
+  }
+  std::unordered_map<Eigen::Index, std::vector<Eigen::Index>> blocks;
+  for (Eigen::Index i = 0; i < n; ++i) blocks[find(i)].push_back(i);
+  for (const auto& [id, members] : blocks) {
+    const auto m = static_cast<Eigen::Index>(members.size());
+    Eigen::MatrixXd B(m, m);
+    for (Eigen::Index r = 0; r < m; ++r)
+      for (Eigen::Index c = 0; c < m; ++c) B(r, c) = N(members[r], members[c]);
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(B);
+    const Eigen::VectorXd pivots = qr.matrixR().diagonal().cwiseAbs();
+    if (!(pivots.minCoeff() > kSingularRatio * pivots.maxCoeff())) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 void Model::finalize() {
   const int n = dof();
   if (n == 0)
     throw Error("model '" + name + "' has no moving joints; add a revolute or prismatic joint");
+  if (n > kMaxJoints) {
+    throw Error("model '" + name + "' has " + std::to_string(n) +
+                " moving joints; dynid handles at most " + std::to_string(kMaxJoints) +
+                " (split the model or merge joints into fixed ones)");
+  }
   if (static_cast<int>(links.size()) != n) {
     throw Error("model '" + name + "' has " + std::to_string(links.size()) +
                 " link parameter sets for " + std::to_string(n) + " joints");
   }
   if (!gravity.allFinite()) throw Error("model '" + name + "' has a non-finite gravity vector");
+  std::unordered_map<std::string, int> first_use;
+  first_use.reserve(static_cast<std::size_t>(n));
+  for (int j = 0; j < n; ++j) {
+    const auto [it, fresh] = first_use.emplace(joints[j].name, j);
+    if (!fresh) {
+      throw Error("model '" + name + "' has two joints named '" + joints[j].name + "' (joints " +
+                  std::to_string(it->second + 1) + " and " + std::to_string(j + 1) +
+                  "); give every joint a unique name");
+    }
+  }
   for (int j = 0; j < n; ++j) {
     Joint& jt = joints[j];
     const std::string who = "joint '" + jt.name + "'";
@@ -126,8 +186,14 @@ void Model::finalize() {
     throw Error("model '" + name + "' has a transmission of the wrong size; it must be " +
                 std::to_string(n) + "x" + std::to_string(n));
   }
-  if (std::abs(transmission.N.determinant()) < 1e-12) {
-    throw Error("model '" + name + "' has a singular transmission matrix; it must be invertible");
+  if (!transmission.N.allFinite() || !transmission.q_offset.allFinite()) {
+    throw Error("model '" + name +
+                "' has a non-finite transmission N or q_offset; give finite values");
+  }
+  if (!transmission_invertible(transmission.N)) {
+    throw Error("model '" + name +
+                "' has a singular transmission matrix N (rank-deficient relative to its largest "
+                "entry); every motor must drive an independent combination of joints");
   }
 }
 

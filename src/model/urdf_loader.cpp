@@ -1,33 +1,63 @@
 #include "dynid/model/urdf_loader.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
-#include <fstream>
+#include <cstdio>
+#include <cstring>
 #include <limits>
 #include <map>
+#include <memory>
 #include <sstream>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
+#include <sys/stat.h>
+
+#include <console_bridge/console.h>
 #include <tinyxml2.h>
 #include <urdf_parser/urdf_parser.h>
 #include <Eigen/Geometry>
 
 #include "dynid/common/error.hpp"
+#include "model/printable.hpp"
 
 namespace dynid {
 
 std::string read_robot_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw Error("cannot open robot file '" + path + "'; check the path and its permissions");
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+    throw Error("robot file '" + path + "' is a directory; give the path of a URDF or YAML file");
   }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
+                                                       &std::fclose);
+  if (!file) {
+    throw Error("cannot open robot file '" + path + "' (" + std::strerror(errno) +
+                "); check the path and its permissions");
+  }
+  // Read with a cap instead of trusting a size: devices and pipes (/dev/zero) have none.
+  std::string text;
+  char buffer[1 << 16];
+  std::size_t got = 0;
+  while ((got = std::fread(buffer, 1, sizeof(buffer), file.get())) > 0) {
+    if (text.size() + got > kMaxRobotFileBytes) {
+      throw Error("robot file '" + path + "' is larger than " +
+                  std::to_string(kMaxRobotFileBytes >> 20) +
+                  " MiB, the limit for a robot description; check that it is the right file");
+    }
+    text.append(buffer, got);
+  }
+  if (std::ferror(file.get())) {
+    throw Error("robot file '" + path + "': read error (" + std::strerror(errno) +
+                "); check the file");
+  }
+  return text;
 }
 
 namespace {
+
+using model_detail::printable;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -68,7 +98,7 @@ LinkParams urdf_link_params(const urdf::Link& link) {
 std::map<std::string, int> joint_file_order(const std::string& xml, const std::string& source) {
   tinyxml2::XMLDocument doc;
   if (doc.Parse(xml.c_str(), xml.size()) != tinyxml2::XML_SUCCESS) {
-    std::string detail = doc.ErrorStr() ? doc.ErrorStr() : "unknown error";
+    const std::string detail = printable(doc.ErrorStr() ? doc.ErrorStr() : "unknown error");
     throw Error("robot file '" + source + "' is not well-formed XML (" + detail +
                 "); fix the XML syntax");
   }
@@ -97,75 +127,86 @@ const char* type_name(int type) {
   }
 }
 
+/// Routes console_bridge (urdfdom's logging) into a buffer for the lifetime of the object, so that
+/// urdfdom prints nothing and its first error can become part of dynid's one-line message.
+class ConsoleCapture : public console_bridge::OutputHandler {
+ public:
+  ConsoleCapture() { console_bridge::useOutputHandler(this); }
+  ~ConsoleCapture() override { console_bridge::restorePreviousOutputHandler(); }
+  ConsoleCapture(const ConsoleCapture&) = delete;
+  ConsoleCapture& operator=(const ConsoleCapture&) = delete;
+
+  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR && first_error_.empty())
+      first_error_ = text;
+  }
+  const std::string& first_error() const { return first_error_; }
+
+ private:
+  std::string first_error_;
+};
+
 class TreeBuilder {
  public:
   TreeBuilder(const urdf::ModelInterface& urdf, const std::map<std::string, int>& order,
               std::string source)
       : urdf_(urdf), order_(order), source_(std::move(source)) {}
 
-  /// Depth-first visit of `link`: `moving_parent` is the index of the nearest moving ancestor (-1
-  /// for the base), `X` is the pose of `link`'s frame in that ancestor's frame.
-  void visit(const urdf::Link& link, int moving_parent, const Pose& X) {
-    std::vector<urdf::JointSharedPtr> children = link.child_joints;
-    std::stable_sort(children.begin(), children.end(),
-                     [this](const urdf::JointSharedPtr& a, const urdf::JointSharedPtr& b) {
-                       return rank(a->name) < rank(b->name);
-                     });
-    for (const auto& uj : children) {
-      const urdf::LinkConstSharedPtr child = urdf_.getLink(uj->child_link_name);
+  /// Depth-first (pre-order) walk from `root` with an explicit stack, so the depth of the tree
+  /// is not limited by the call stack; a link reached twice (a joint whose child is its own
+  /// parent, or a cycle below the root) is an error. Each stack entry is a joint still to be
+  /// visited, with the index of the nearest moving ancestor of its parent link (-1 for the base)
+  /// and the pose of the parent link's frame in that ancestor's frame.
+  void build(const urdf::Link& root) {
+    struct Pending {
+      urdf::JointSharedPtr joint;
+      int moving_parent;
+      Pose X;
+    };
+    std::vector<Pending> stack;
+    std::unordered_set<std::string> seen{root.name};
+    push_children(root, -1, Pose{}, stack);
+    while (!stack.empty()) {
+      const Pending top = std::move(stack.back());
+      stack.pop_back();
+      const urdf::Joint& uj = *top.joint;
+      const urdf::LinkConstSharedPtr child = urdf_.getLink(uj.child_link_name);
       if (!child) {
-        throw Error("joint '" + uj->name + "' in '" + source_ + "' names a missing child link '" +
-                    uj->child_link_name + "'; add that <link>");
+        throw Error("joint '" + uj.name + "' in '" + source_ + "' names a missing child link '" +
+                    uj.child_link_name + "'; add that <link>");
       }
-      const Pose X_child = X * to_pose(uj->parent_to_joint_origin_transform);
-      switch (uj->type) {
+      if (!seen.insert(child->name).second) {
+        throw Error("joint '" + uj.name + "' in '" + source_ + "' leads back to link '" +
+                    child->name +
+                    "', which is already in the tree (a cycle); a URDF must be a tree: give every "
+                    "link one parent joint and no joint its own parent as child");
+      }
+      const Pose X_child = top.X * to_pose(uj.parent_to_joint_origin_transform);
+      switch (uj.type) {
         case urdf::Joint::FIXED: {
-          if (moving_parent >= 0) {
+          if (top.moving_parent >= 0) {
             // Merge: the child's parameters, expressed about the moving ancestor's origin.
-            model_.links[moving_parent] +=
+            model_.links[top.moving_parent] +=
                 transform_link_params(urdf_link_params(*child), X_child.R, X_child.p);
           }
-          visit(*child, moving_parent, X_child);
+          push_children(*child, top.moving_parent, X_child, stack);
           break;
         }
         case urdf::Joint::REVOLUTE:
         case urdf::Joint::CONTINUOUS:
         case urdf::Joint::PRISMATIC: {
-          Joint j;
-          j.name = uj->name;
-          j.link_name = child->name;
-          j.type =
-              uj->type == urdf::Joint::PRISMATIC ? JointType::kPrismatic : JointType::kRevolute;
-          j.parent = moving_parent;
-          j.R_PJ = X_child.R;
-          j.p_PJ = X_child.p;
-          j.axis = Eigen::Vector3d(uj->axis.x, uj->axis.y, uj->axis.z);
-          if (uj->limits) {
-            if (uj->type != urdf::Joint::CONTINUOUS) {
-              j.limits.lower = uj->limits->lower;
-              j.limits.upper = uj->limits->upper;
-            }
-            j.limits.velocity = uj->limits->velocity > 0.0 ? uj->limits->velocity : kInf;
-            j.limits.effort = uj->limits->effort > 0.0 ? uj->limits->effort : kInf;
+          if (model_.dof() >= kMaxJoints) {
+            throw Error("robot file '" + source_ + "' has more than " + std::to_string(kMaxJoints) +
+                        " moving joints, the limit of dynid; split the model or make joints fixed");
           }
-          if (uj->dynamics) {
-            j.friction.Fv = uj->dynamics->damping;
-            j.friction.Fc = uj->dynamics->friction;
-          }
-          if (!std::isfinite(j.friction.Fv) || !std::isfinite(j.friction.Fc) ||
-              j.friction.Fv < 0.0 || j.friction.Fc < 0.0) {
-            throw Error("joint '" + uj->name + "' in '" + source_ +
-                        "' has a negative or non-finite <dynamics damping/friction>; give values "
-                        ">= 0");
-          }
-          model_.joints.push_back(j);
+          model_.joints.push_back(moving_joint(uj, *child, top.moving_parent, X_child));
           model_.links.push_back(urdf_link_params(*child));
-          visit(*child, static_cast<int>(model_.joints.size()) - 1, Pose{});
+          push_children(*child, model_.dof() - 1, Pose{}, stack);
           break;
         }
         default:
-          throw Error("joint '" + uj->name + "' in '" + source_ + "' has unsupported type '" +
-                      type_name(uj->type) +
+          throw Error("joint '" + uj.name + "' in '" + source_ + "' has unsupported type '" +
+                      type_name(uj.type) +
                       "'; supported types are revolute, continuous, prismatic and fixed");
       }
     }
@@ -174,6 +215,48 @@ class TreeBuilder {
   Model& model() { return model_; }
 
  private:
+  // Pushes the child joints of `link` so that they pop in file order.
+  template <typename Stack>
+  void push_children(const urdf::Link& link, int moving_parent, const Pose& X, Stack& stack) const {
+    std::vector<urdf::JointSharedPtr> children = link.child_joints;
+    std::stable_sort(children.begin(), children.end(),
+                     [this](const urdf::JointSharedPtr& a, const urdf::JointSharedPtr& b) {
+                       return rank(a->name) < rank(b->name);
+                     });
+    for (auto it = children.rbegin(); it != children.rend(); ++it)
+      stack.push_back({*it, moving_parent, X});
+  }
+
+  Joint moving_joint(const urdf::Joint& uj, const urdf::Link& child, int moving_parent,
+                     const Pose& X_child) const {
+    Joint j;
+    j.name = uj.name;
+    j.link_name = child.name;
+    j.type = uj.type == urdf::Joint::PRISMATIC ? JointType::kPrismatic : JointType::kRevolute;
+    j.parent = moving_parent;
+    j.R_PJ = X_child.R;
+    j.p_PJ = X_child.p;
+    j.axis = Eigen::Vector3d(uj.axis.x, uj.axis.y, uj.axis.z);
+    if (uj.limits) {
+      if (uj.type != urdf::Joint::CONTINUOUS) {
+        j.limits.lower = uj.limits->lower;
+        j.limits.upper = uj.limits->upper;
+      }
+      j.limits.velocity = uj.limits->velocity > 0.0 ? uj.limits->velocity : kInf;
+      j.limits.effort = uj.limits->effort > 0.0 ? uj.limits->effort : kInf;
+    }
+    if (uj.dynamics) {
+      j.friction.Fv = uj.dynamics->damping;
+      j.friction.Fc = uj.dynamics->friction;
+    }
+    if (!std::isfinite(j.friction.Fv) || !std::isfinite(j.friction.Fc) || j.friction.Fv < 0.0 ||
+        j.friction.Fc < 0.0) {
+      throw Error("joint '" + uj.name + "' in '" + source_ +
+                  "' has a negative or non-finite <dynamics damping/friction>; give values >= 0");
+    }
+    return j;
+  }
+
   int rank(const std::string& name) const {
     const auto it = order_.find(name);
     return it == order_.end() ? std::numeric_limits<int>::max() : it->second;
@@ -189,16 +272,23 @@ class TreeBuilder {
 
 Model parse_urdf(const std::string& xml, const std::string& source) {
   const std::map<std::string, int> order = joint_file_order(xml, source);
-  const urdf::ModelInterfaceSharedPtr urdf = urdf::parseURDF(xml);
+  urdf::ModelInterfaceSharedPtr urdf;
+  std::string urdfdom_message;
+  {
+    const ConsoleCapture capture;  // urdfdom reports through console_bridge: keep it off stderr
+    urdf = urdf::parseURDF(xml);
+    urdfdom_message = capture.first_error();
+  }
   if (!urdf) {
-    throw Error("robot file '" + source +
-                "' is not a valid URDF (urdfdom rejected it; its message is printed above); fix "
-                "the file");
+    throw Error("robot file '" + source + "' is not a valid URDF (" +
+                (urdfdom_message.empty() ? std::string("rejected by urdfdom")
+                                         : printable(urdfdom_message)) +
+                "); fix the file");
   }
   const urdf::LinkConstSharedPtr root = urdf->getRoot();
   if (!root) throw Error("robot file '" + source + "' has no root link; add a <link>");
   TreeBuilder builder(*urdf, order, source);
-  builder.visit(*root, -1, Pose{});
+  builder.build(*root);
   Model model = std::move(builder.model());
   model.name = urdf->getName();
   model.source = source;

@@ -18,7 +18,9 @@
 #include "dynid/excitation/trajectory_samples.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
+#include "support/error_of.hpp"
 #include "support/planar2.hpp"
+#include "support/random_models.hpp"
 
 namespace dynid {
 namespace {
@@ -195,6 +197,26 @@ TEST(ExcitationOptimization, Errors) {
   o = small_options();
   FourierCoefficients c = FourierCoefficients::zeros({2, 2}, o.f0);
   EXPECT_THROW(evaluate_excitation(model, c, o, 30), Error);  // 2 harmonics, options say 3
+}
+
+// Issue 10: `excite` ignored --max-time on a 500-link tree (the base parameters and every
+// evaluation ran to the end). Now the budget covers them: with a budget far below one evaluation
+// of a 300-joint tree (each sample of the criterion is a rank update of a ~2000² matrix), the
+// result is the budget error, not minutes of work.
+TEST(ExcitationOptimization, MaxTimeBoundsLargeTrees) {
+  const Model model = testing::random_tree(300, 17, false);
+  ExcitationOptions o;
+  o.f0 = 0.1;
+  o.harmonics = 2;
+  o.max_time = 0.05;
+  o.q_min = Eigen::VectorXd::Constant(300, -1.0);
+  o.q_max = Eigen::VectorXd::Constant(300, 1.0);
+  o.dq_max = Eigen::VectorXd::Constant(300, 1.0);
+  o.ddq_max = Eigen::VectorXd::Constant(300, 2.0);
+  const std::string msg = testing::error_of([&] { optimize_excitation(model, o); });
+  EXPECT_TRUE(msg.find("max_time") != std::string::npos ||
+              msg.find("--max-time") != std::string::npos)
+      << msg;
 }
 
 }  // namespace

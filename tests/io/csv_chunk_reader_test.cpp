@@ -74,5 +74,30 @@ TEST(CsvChunkReader, ErrorsNameFileAndLine) {
   EXPECT_HAS(error_of([&] { truncated.next(block); }), "t.csv:3: truncated last line");
 }
 
+// Issue 10: BOM, CR-only line ends and /dev/zero, for the streaming reader too.
+TEST(CsvChunkReader, ByteOrderMarkCrOnlyAndLineLimit) {
+  TempDir dir;
+  CsvChunkOptions options;
+  options.chunk_rows = 2;
+  options.buffer_bytes = 64;  // lines cross buffer refills
+  CsvChunkReader bom(dir.write("bom.csv", "\xEF\xBB\xBFt,q1\n0,1\n0.1,2\n0.2,3\n"), options);
+  EXPECT_EQ(bom.columns(), (std::vector<std::string>{"t", "q1"}));
+  std::string mac_text = "t,q1\r";
+  for (int k = 0; k < 40; ++k) mac_text += std::to_string(k) + ",1.5\r";
+  CsvChunkReader mac(dir.write("mac.csv", mac_text), options);
+  EXPECT_EQ(mac.columns(), (std::vector<std::string>{"t", "q1"}));
+  Eigen::MatrixXd block;
+  Eigen::Index rows = 0;
+  double last_t = -1.0;
+  while (mac.next(block)) {
+    rows += block.rows();
+    last_t = block(block.rows() - 1, 0);
+  }
+  EXPECT_EQ(rows, 40);
+  EXPECT_EQ(last_t, 39.0);
+  const std::string m = error_of([] { CsvChunkReader zero("/dev/zero"); });
+  EXPECT_HAS(m, "/dev/zero:1: line is longer than 1 MiB");
+}
+
 }  // namespace
 }  // namespace dynid

@@ -96,5 +96,43 @@ TEST(CsvReader, TruncatedLastLine) {
   EXPECT_HAS(error_of([] { parse_csv("a,b,c\n1,2,3\n4,5\n", "tr.csv"); }), "row has 2 fields");
 }
 
+// Issue 10: a UTF-8 byte-order mark hid the `t` column (its name became "\xEF\xBB\xBFt").
+TEST(CsvReader, ByteOrderMarkIsSkipped) {
+  const CsvTable t = parse_csv("\xEF\xBB\xBFt,q1\n0,1\n0.1,2\n", "bom.csv");
+  EXPECT_EQ(t.columns, (std::vector<std::string>{"t", "q1"}));
+  ASSERT_EQ(t.rows(), 2);
+  TempDir dir;
+  const CsvTable f = read_csv(dir.write("bom.csv", "\xEF\xBB\xBF# comment\nt,q1\n0,1\n"));
+  EXPECT_EQ(f.columns, (std::vector<std::string>{"t", "q1"}));
+}
+
+// Issue 10: CR-only line ends (classic Mac) were read as one header line.
+TEST(CsvReader, CrOnlyLineEnds) {
+  const CsvTable t = parse_csv("t,q1\r# c\r0,1\r0.1,2.5\r", "mac.csv");
+  EXPECT_EQ(t.columns, (std::vector<std::string>{"t", "q1"}));
+  ASSERT_EQ(t.rows(), 2);
+  EXPECT_EQ(t.data(1, 1), 2.5);
+  EXPECT_EQ(t.lines, (std::vector<long>{3, 4}));
+}
+
+// Issue 10: /dev/zero was read until memory ran out. The read stops one line length later.
+TEST(CsvReader, SizeLimits) {
+  std::string m = error_of([] { read_csv("/dev/zero"); });
+  EXPECT_HAS(m, "/dev/zero:1: line is longer than 1 MiB");
+  std::string wide = "c0";
+  for (std::size_t c = 1; c <= kMaxCsvColumns; ++c) wide += ",c" + std::to_string(c);
+  m = error_of([&] { parse_csv(wide + "\n", "wide.csv"); });
+  EXPECT_HAS(m, "wide.csv:1: header has " + std::to_string(kMaxCsvColumns + 1) + " columns");
+  TempDir dir;
+  // A sparse file one byte over the in-memory limit: refused from its size, nothing is read.
+  const std::string big = dir.write("big.csv", "t\n");
+  std::filesystem::resize_file(big, kMaxCsvFileBytes + 1);
+  m = error_of([&] { read_csv(big); });
+  EXPECT_HAS(m, "larger than 256 MiB");
+  EXPECT_HAS(m, "--stream");
+  m = error_of([&] { read_csv(dir.path().string()); });
+  EXPECT_HAS(m, "is a directory");
+}
+
 }  // namespace
 }  // namespace dynid

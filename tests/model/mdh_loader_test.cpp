@@ -195,6 +195,79 @@ TEST(MdhLoader, UrdfWrapperAppliesOverrides) {
   EXPECT_DOUBLE_EQ(model.joints[1].friction.Fo, -0.1);
 }
 
+// Issue 10: an absolute determinant test rejected N = 0.001·I as singular, and took O(n³).
+TEST(MdhLoader, TransmissionTestIsScaleInvariant) {
+  const std::string rows = std::string("joints:\n") +
+                           "  - {sigma: 0, alpha: 0, d: 0, theta: 0, r: 0, " + kInertia + "}\n" +
+                           "  - {sigma: 0, alpha: 0, d: 1, theta: 0, r: 0, " + kInertia + "}\n" +
+                           "  - {sigma: 0, alpha: 0, d: 1, theta: 0, r: 0, " + kInertia + "}\n";
+  const Model small =
+      parse_yaml_model(rows + "gear_ratios: [0.001, 0.001, 0.001]\n", "s.yaml", ".");
+  EXPECT_EQ(small.transmission.N, 0.001 * Eigen::Matrix3d::Identity());
+  // det = 1e-12·(1·1 − 0.5·0.5)·… tiny, but well conditioned: accepted.
+  const Model coupled = parse_yaml_model(
+      rows + "transmission: {N: [[1e-4, 0, 0], [0, 1e-4, 0], [0, 5e-5, 1e-4]]}\n", "c.yaml", ".");
+  EXPECT_FALSE(coupled.transmission.is_identity());
+  // Rank-deficient whatever the scale: row 3 = row 2 (coupled block), or a zero gear ratio.
+  std::string msg = error_of([&] {
+    parse_yaml_model(rows + "transmission: {N: [[1e6, 0, 0], [0, 2e6, 1e6], [0, 2e6, 1e6]]}\n",
+                     "d.yaml", ".");
+  });
+  EXPECT_NE(msg.find("singular transmission matrix"), std::string::npos) << msg;
+  msg = error_of([&] { parse_yaml_model(rows + "gear_ratios: [100, 0, 50]\n", "z.yaml", "."); });
+  EXPECT_NE(msg.find("singular transmission matrix"), std::string::npos) << msg;
+}
+
+// Issue 10: duplicate joint names were accepted and failed later inside MuJoCo.
+TEST(MdhLoaderErrors, DuplicateJointNames) {
+  const std::string yaml =
+      std::string("joints:\n") + "  - {name: a, sigma: 0, alpha: 0, d: 0, theta: 0, r: 0, " +
+      kInertia + "}\n" + "  - {name: b, sigma: 0, alpha: 0, d: 1, theta: 0, r: 0, " + kInertia +
+      "}\n" + "  - {name: a, sigma: 0, alpha: 0, d: 1, theta: 0, r: 0, " + kInertia + "}\n";
+  const std::string msg = error_of([&] { parse_yaml_model(yaml, "dup.yaml", "."); });
+  EXPECT_NE(msg.find("robot file 'dup.yaml': joints[3] ('a').name: repeats the name of joints[1]"),
+            std::string::npos)
+      << msg;
+  // Models built by hand get the same check in Model::finalize.
+  Model m = parse_yaml_model(
+      std::string("joints:\n") + "  - {name: a, sigma: 0, alpha: 0, d: 0, theta: 0, r: 0, " +
+          kInertia + "}\n" + "  - {name: b, sigma: 0, alpha: 0, d: 1, theta: 0, r: 0, " + kInertia +
+          "}\n",
+      "ok.yaml", ".");
+  m.joints[1].name = "a";
+  const std::string fin = error_of([&] { m.finalize(); });
+  EXPECT_NE(fin.find("two joints named 'a' (joints 1 and 2)"), std::string::npos) << fin;
+}
+
+// Issue 10: yaml-cpp text was echoed raw; input text in messages is escaped (no control characters,
+// valid UTF-8 only) and the message names file and line.
+TEST(MdhLoaderErrors, YamlMessagesNameLineAndEscapeInput) {
+  const std::string msg = error_of([] {
+    parse_yaml_model(
+        "joints:\n  - {sigma: 0, alpha: \"x\\ty\\u0007\\xff\", d: 0, theta: 0, r: 0}\n", "e.yaml",
+        ".");
+  });
+  EXPECT_NE(msg.find("'x\\ty\\x07\xc3\xbf' is not a number"), std::string::npos) << msg;
+  for (char c : msg) EXPECT_FALSE(static_cast<unsigned char>(c) < 0x20) << msg;
+  const std::string bad = error_of([] { parse_yaml_model("joints: [1, 2\n\n", "f.yaml", "."); });
+  EXPECT_NE(bad.find("robot file 'f.yaml', line "), std::string::npos) << bad;
+  for (char c : bad) EXPECT_FALSE(static_cast<unsigned char>(c) < 0x20) << bad;
+}
+
+// Issue 10: `urdf: /dev/zero` read until memory ran out; more rows than kMaxJoints are refused
+// before any is read.
+TEST(MdhLoaderErrors, SizeLimits) {
+  std::string msg = error_of([] { parse_yaml_model("urdf: /dev/zero\n", "z.yaml", "."); });
+  EXPECT_NE(msg.find("robot file '/dev/zero' is larger than 64 MiB"), std::string::npos) << msg;
+  std::string rows = "joints:\n";
+  for (int j = 0; j <= kMaxJoints; ++j) rows += "  - {sigma: 0}\n";
+  msg = error_of([&] { parse_yaml_model(rows, "big.yaml", "."); });
+  EXPECT_NE(
+      msg.find("joints: has " + std::to_string(kMaxJoints + 1) + " rows; dynid handles at most"),
+      std::string::npos)
+      << msg;
+}
+
 TEST(MdhLoaderErrors, WrongTransmissionSize) {
   const std::string msg = error_of([] { load_yaml_model(kData + "bad_transmission.yaml"); });
   EXPECT_NE(msg.find("transmission.N"), std::string::npos) << msg;
@@ -226,7 +299,8 @@ TEST(MdhLoaderErrors, UnknownKeyNegativeMassBadYamlAndUnknownJoint) {
   });
   EXPECT_NE(msg.find("joints[1].mass: is negative"), std::string::npos) << msg;
   msg = error_of([] { parse_yaml_model("joints: [ {sigma: 0", "t.yaml", "."); });
-  EXPECT_NE(msg.find("is not valid YAML"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("robot file 't.yaml', line 1, column "), std::string::npos) << msg;
+  EXPECT_NE(msg.find(": not valid YAML ("), std::string::npos) << msg;
   msg = error_of(
       [] { parse_yaml_model("urdf: two_link.urdf\nfriction: {j9: {Fv: 1}}\n", "w.yaml", kData); });
   EXPECT_NE(msg.find("friction.j9: no joint of that name; joints are j1, j2"), std::string::npos)

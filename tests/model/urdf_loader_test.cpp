@@ -1,4 +1,5 @@
 #include "dynid/model/urdf_loader.hpp"
+#include "support/chain_urdf.hpp"
 #include "support/error_of.hpp"
 
 #include <cmath>
@@ -286,6 +287,82 @@ TEST(UrdfLoaderErrors, NoMovingJoint) {
 TEST(UrdfLoaderErrors, NotAUrdf) {
   const std::string msg = error_of([] { parse_urdf("<robotx/>", "x.urdf"); });
   EXPECT_NE(msg.find("no <robot> element"), std::string::npos) << msg;
+}
+
+// Issue 10: a joint whose child is its own parent recursed without end in the tree builder.
+TEST(UrdfLoaderErrors, JointWhoseChildIsItsOwnParentIsACycle) {
+  const std::string xml = R"(<robot name="loop"><link name="a"/><link name="b"/>
+    <joint name="j1" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>
+      <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+    <joint name="j2" type="continuous"><parent link="b"/><child link="b"/></joint></robot>)";
+  const std::string msg = error_of([&] { parse_urdf(xml, "loop.urdf"); });
+  EXPECT_NE(msg.find("joint 'j2' in 'loop.urdf' leads back to link 'b'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("must be a tree"), std::string::npos) << msg;
+}
+
+TEST(UrdfLoaderErrors, CycleBelowTheRoot) {
+  const std::string xml = R"(<robot name="ring"><link name="a"/><link name="b"/><link name="c"/>
+    <joint name="j1" type="continuous"><parent link="a"/><child link="b"/></joint>
+    <joint name="j2" type="continuous"><parent link="b"/><child link="c"/></joint>
+    <joint name="j3" type="fixed"><parent link="c"/><child link="b"/></joint></robot>)";
+  std::string msg;
+  ::testing::internal::CaptureStderr();
+  ::testing::internal::CaptureStdout();
+  msg = error_of([&] { parse_urdf(xml, "ring.urdf"); });
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  const std::string out = ::testing::internal::GetCapturedStdout();
+  // urdfdom may reject the file itself (two parents for b) or leave the cycle to the tree builder;
+  // either way one dynid error and no console output.
+  EXPECT_NE(msg.find("ring.urdf"), std::string::npos) << msg;
+  EXPECT_EQ(err, "");
+  EXPECT_EQ(out, "");
+}
+
+// Issue 10: a chain of ~12 000 links overflowed the stack of the recursive builder. 4000 moving
+// joints, each followed by two fixed links: 12 000 links deep.
+TEST(UrdfLoader, TwelveThousandLinksDeepLoadIteratively) {
+  const Model model = parse_urdf(testing::chain_urdf(4000, 3, 2), "deep.urdf");
+  ASSERT_EQ(model.dof(), 4000);
+  EXPECT_EQ(model.joints[3999].parent, 3998);
+  // Each moving link (1 to 2 kg) carries its two fixed bodies of 0.01 kg.
+  for (int j = 0; j < model.dof(); ++j) {
+    EXPECT_GE(model.links[j](9), 1.02 - 1e-12) << j;
+    EXPECT_LE(model.links[j](9), 2.02 + 1e-12) << j;
+  }
+  EXPECT_TRUE(model.transmission.is_identity());
+}
+
+TEST(UrdfLoaderErrors, MoreThanTheJointLimit) {
+  const std::string msg =
+      error_of([] { parse_urdf(testing::chain_urdf(kMaxJoints + 1, 4), "huge.urdf"); });
+  EXPECT_NE(msg.find("more than " + std::to_string(kMaxJoints) + " moving joints"),
+            std::string::npos)
+      << msg;
+}
+
+// Issue 10: urdfdom's console_bridge lines preceded dynid's error for every rejected URDF.
+TEST(UrdfLoaderErrors, UrdfdomMessageBecomesPartOfTheOneLineError) {
+  const std::string xml = R"(<robot name="r"><link name="a"/>
+    <joint name="j1" type="revolute"><parent link="a"/><child link="nowhere"/>
+      <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>)";
+  ::testing::internal::CaptureStderr();
+  ::testing::internal::CaptureStdout();
+  const std::string msg = error_of([&] { parse_urdf(xml, "r.urdf"); });
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  const std::string out = ::testing::internal::GetCapturedStdout();
+  EXPECT_EQ(err, "");
+  EXPECT_EQ(out, "");
+  EXPECT_NE(msg.find("robot file 'r.urdf' is not a valid URDF ("), std::string::npos) << msg;
+  EXPECT_NE(msg.find("nowhere"), std::string::npos) << msg;  // urdfdom's reason, in dynid's line
+  EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+}
+
+// Issue 10: reading /dev/zero as a robot file read until memory ran out.
+TEST(UrdfLoaderErrors, DeviceWithoutEndIsCutAtTheSizeLimit) {
+  const std::string msg = error_of([] { load_urdf("/dev/zero"); });
+  EXPECT_NE(msg.find("robot file '/dev/zero' is larger than 64 MiB"), std::string::npos) << msg;
+  const std::string dir = error_of([] { load_urdf(kData); });
+  EXPECT_NE(dir.find("is a directory"), std::string::npos) << dir;
 }
 
 }  // namespace

@@ -62,10 +62,11 @@ struct ExcitationOptions {
   double grid_margin = 0.03;
   double workspace_margin = 0.01;  ///< same for the workspace planes, in metres [m]
 
-  int starts = 4;                      ///< multi-start: number of random initial points
-  unsigned seed = 20261123;            ///< seed of the random initial points (deterministic runs)
-  int max_evaluations = 3000;          ///< evaluation budget per start
-  double max_time = 10.0;              ///< wall-clock budget for all starts together [s]; 0 = none
+  int starts = 4;              ///< multi-start: number of random initial points
+  unsigned seed = 20261123;    ///< seed of the random initial points (deterministic runs)
+  int max_evaluations = 3000;  ///< evaluation budget per start
+  double max_time = 10.0;      ///< wall-clock budget of base parameters + all starts [s]; 0 = none
+                               ///< (the final fine-grid check gets one more max_time at most)
   double relative_tolerance = 1e-6;    ///< NLopt relative tolerance on the criterion and x
   double constraint_tolerance = 1e-9;  ///< NLopt tolerance on the (normalised) constraints
 };

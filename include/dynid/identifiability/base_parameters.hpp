@@ -17,17 +17,27 @@ enum class BaseRegressor {
             ///< no energy, so only the link and armature columns are classified from it
 };
 
+/// How compute_base_parameters finds the base parameters.
+enum class BaseAlgorithm {
+  kAuto,   ///< kTree for the torque regressor without coupled motors, else kDense
+  kDense,  ///< left-to-right sweep over the whole sampled regressor: O(n³) time, O(n²) memory
+  kTree,   ///< null space from local systems of each link and its parent: O(n) sampling, O(n²)
+           ///< only for K_d (docs/methods/model.md, "Base parameters of large trees")
+};
+
 /// Options of the numerical base-parameter computation.
 struct BaseParameterOptions {
   ParameterLayout layout;  ///< columns to classify (link + per-joint terms)
   bool coupling =
       false;  ///< append the coupled-motor columns (model/transmission.hpp), torque only
   BaseRegressor regressor = BaseRegressor::kTorque;  ///< which model is sampled
-  int samples = 0;           ///< random states; 0 = max(100, 4·columns/n) (enough for full rank)
-  unsigned seed = 20261123;  ///< fixed seed: the same model gives the same base set every time
-  double zero_tolerance = 1e-10;       ///< column norm / largest column norm below this: no effect
+  BaseAlgorithm algorithm = BaseAlgorithm::kAuto;    ///< same result either way (tested)
+  int samples = 0;  ///< random states; 0 = 40 (tree) or max(100, 4·columns/n + 50) (dense)
+  unsigned seed = 20261123;       ///< fixed seed: the same model gives the same base set every time
+  double zero_tolerance = 1e-10;  ///< column norm / largest column norm below this: no effect
   double dependence_tolerance = 1e-8;  ///< residual / own norm below this: linearly dependent
   double coefficient_digits = 6;       ///< significant digits of K_d in the expressions
+  double max_seconds = 0.0;  ///< wall-clock limit [s]; 0 = none; beyond it dynid::Error is thrown
 };
 
 /// The base (identifiable) parameters: theta_b = theta_1 + K_d·theta_2 (Gautier–Khalil 1990).
@@ -41,6 +51,7 @@ struct BaseParameters {
   std::vector<std::string> expressions;   ///< `ZZ2R = ZZ2 + 0.2025*M3 + YY3`
   std::vector<std::string> layout_names;  ///< names of every layout column
   int samples = 0;                        ///< random states used
+  BaseAlgorithm algorithm = BaseAlgorithm::kDense;  ///< the algorithm that produced it
 
   /// theta_b = theta_1 + K_d·theta_2 for a full layout vector theta.
   Eigen::VectorXd reduce(const Eigen::Ref<const Eigen::VectorXd>& theta) const;
@@ -55,8 +66,11 @@ struct BaseParameters {
 /// of robots"): sample the regressor at random states, keep the columns that are independent of the
 /// columns before them (a left-to-right rank-revealing sweep, so each base parameter is named after
 /// the earliest standard parameter it contains, as in Khalil's regrouping rules), and solve
-/// W_2 = W_1·K_d by least squares. Deterministic for a given model and options.
-/// Throws dynid::Error if the model has no identifiable parameter.
+/// W_2 = W_1·K_d by least squares. Deterministic for a given model and options. For the torque
+/// regressor the same classification comes from the tree structure in near-linear time
+/// (BaseAlgorithm::kTree, the default there). Throws dynid::Error if the model has no identifiable
+/// parameter, when options.max_seconds runs out, and when the dense sweep would need more than
+/// 2 GB.
 BaseParameters compute_base_parameters(const Model& model,
                                        const BaseParameterOptions& options = {});
 

@@ -14,6 +14,10 @@ enum class JointType { kRevolute, kPrismatic };
 /// Number of standard inertial parameters per link (DESIGN.md section 3).
 inline constexpr int kLinkParams = 10;
 
+/// Largest number of moving joints a model may have (docs/cli.md, "Input size limits"): the dense
+/// n×n transmission matrix alone takes 8·n² bytes, 200 MB at this limit.
+inline constexpr int kMaxJoints = 5000;
+
 /// Standard inertial parameters of one link, in link frame j, about the link ORIGIN, in the order
 /// XX XY XZ YY YZ ZZ MX MY MZ M (kg·m², kg·m, kg). MX = m·c_x.
 using LinkParams = Eigen::Matrix<double, kLinkParams, 1>;
@@ -73,8 +77,10 @@ struct Model {
 
   /// Checks consistency (parents precede children, unit axes, orthonormal rotations, sizes,
   /// physical inertias: m ≥ 0 and the rotational inertia about the centre of mass positive
-  /// semi-definite with the triangle inequality) and fills defaults (identity transmission).
-  /// Throws dynid::Error naming the joint or link at fault.
+  /// semi-definite with the triangle inequality), the joint count (at most kMaxJoints), duplicate
+  /// joint names, and an invertible transmission (scale-invariant test, linear time for a diagonal
+  /// N) and fills defaults (identity transmission). Throws dynid::Error naming the joint or link at
+  /// fault.
   void finalize();
 
   /// The standard parameter vector theta (10 per link, DESIGN.md section 3 order), size 10·n.

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include "dynid/model/model.hpp"
@@ -28,7 +29,12 @@ Model load_urdf(const std::string& path);
 /// no moving joint, and every check of Model::finalize (non-physical inertia, ...).
 Model parse_urdf(const std::string& xml, const std::string& source);
 
-/// Reads a whole text file. Throws dynid::Error "cannot open robot file '<path>'; ..." on failure.
+/// Largest robot description file (URDF or YAML) read_robot_file accepts [bytes]; docs/cli.md.
+inline constexpr std::size_t kMaxRobotFileBytes = std::size_t{64} << 20;
+
+/// Reads a whole text file, at most kMaxRobotFileBytes (read with a cap, so devices and pipes such
+/// as /dev/zero end in an error, not in exhausted memory). Throws dynid::Error "cannot open robot
+/// file '<path>'; ..." on failure, for a directory and for a file above the limit.
 std::string read_robot_file(const std::string& path);
 
 }  // namespace dynid
