@@ -1,5 +1,6 @@
 #include "dynid/common/message.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 
@@ -66,13 +67,17 @@ std::string drop_library_tags(std::string_view text) {
   return out;
 }
 
-}  // namespace
-
-std::string one_line(std::string_view text) {
-  const std::string plain = drop_library_tags(text);
+// Escapes control characters (`\n`, `\r`, `\t`, `\xNN`, C1 controls too) and bytes that are
+// not valid UTF-8 (`\xNN`); valid multi-byte UTF-8 is kept. Stops after `max_bytes` of output, at
+// a character boundary, and appends "..." when it cut the text.
+std::string escape(std::string_view plain, std::size_t max_bytes) {
   std::string out;
-  out.reserve(plain.size());
+  out.reserve(std::min(plain.size(), max_bytes) + 4);
   for (std::size_t i = 0; i < plain.size();) {
+    if (out.size() >= max_bytes) {
+      out += "...";
+      break;
+    }
     const unsigned char c = static_cast<unsigned char>(plain[i]);
     const std::size_t len = utf8_length(plain, i);
     if (len == 0) {
@@ -99,9 +104,23 @@ std::string one_line(std::string_view text) {
       i += len;
     }
   }
-  const auto first = out.find_first_not_of(' ');
+  return out;
+}
+
+std::string trim_blanks(const std::string& text) {
+  const auto first = text.find_first_not_of(' ');
   if (first == std::string::npos) return {};
-  return out.substr(first, out.find_last_not_of(' ') - first + 1);
+  return text.substr(first, text.find_last_not_of(' ') - first + 1);
+}
+
+}  // namespace
+
+std::string one_line(std::string_view text) {
+  return trim_blanks(escape(drop_library_tags(text), std::string::npos));
+}
+
+std::string printable(std::string_view text, std::size_t max_bytes) {
+  return trim_blanks(escape(text, max_bytes));
 }
 
 std::string short_number(double x) {

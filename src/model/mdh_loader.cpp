@@ -13,8 +13,8 @@
 #include <Eigen/Geometry>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/model/urdf_loader.hpp"
-#include "model/printable.hpp"
 
 namespace dynid {
 
@@ -32,8 +32,6 @@ Joint mdh_joint(const MdhRow& row) {
 }
 
 namespace {
-
-using model_detail::printable;
 
 /// Context for one-line error messages: "<source>: <where>: <problem>; <fix>".
 struct Ctx {

@@ -21,7 +21,7 @@
 #include <Eigen/Geometry>
 
 #include "dynid/common/error.hpp"
-#include "model/printable.hpp"
+#include "dynid/common/message.hpp"
 
 namespace dynid {
 
@@ -56,8 +56,6 @@ std::string read_robot_file(const std::string& path) {
 }
 
 namespace {
-
-using model_detail::printable;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 

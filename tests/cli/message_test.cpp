@@ -34,6 +34,14 @@ TEST(Message, KeepsValidUtf8) {
   EXPECT_EQ(valid_utf8(text), text);
 }
 
+TEST(Message, PrintableKeepsTagsAndCutsLongInputAtACharacterBoundary) {
+  EXPECT_EQ(printable("[a.b] x\n"), "[a.b] x\\n");  // input text is quoted, not cleaned of tags
+  EXPECT_EQ(printable(std::string(500, 'a'), 10), std::string(10, 'a') + "...");
+  // 'é' is two bytes: a cut after 9 bytes must not split it.
+  EXPECT_EQ(printable("aaaaaaaaa\xc3\xa9zz", 10), "aaaaaaaaa\xc3\xa9...");
+  EXPECT_EQ(printable("\x01\xff", 40), "\\x01\\xFF");
+}
+
 TEST(Message, ValidUtf8ReplacesEachBadByte) {
   EXPECT_EQ(valid_utf8("run\xff.csv"), "run\xEF\xBF\xBD.csv");
   EXPECT_EQ(valid_utf8("\xe2\x82"), "\xEF\xBF\xBD\xEF\xBF\xBD");

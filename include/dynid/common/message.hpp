@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <string_view>
 
@@ -11,6 +12,11 @@ namespace dynid {
 /// surrounding blanks. Valid multi-byte UTF-8 (N·m, names in any script) is kept. The result is
 /// one line of valid UTF-8 with no control characters; it is empty only when `text` is blank.
 std::string one_line(std::string_view text);
+
+/// Input text (a name, a value, a library's reason) made safe to quote in a one-line message: as
+/// one_line() but without dropping tags, cut after `max_bytes` at a character boundary with "..."
+/// appended, so that a long or binary input cannot flood the message.
+std::string printable(std::string_view text, std::size_t max_bytes = 200);
 
 /// `x` in 4 significant digits for messages ("1.6e+07", "0.2", "inf"), so that a value from the
 /// input never floods a message with hundreds of digits as std::to_string(1e300) would.
