@@ -11,6 +11,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
 
 #include "dynid/common/error.hpp"
@@ -66,6 +67,9 @@ inline void require_valid_model(const Model& model) {
     require(joint.R_PJ.allFinite() && joint.p_PJ.allFinite() && joint.axis.allFinite(),
             "finite joint frames");
   }
+  std::set<std::string> names;
+  for (const Joint& joint : model.joints) names.insert(joint.name);
+  require(names.size() == model.joints.size(), "unique joint names");
   require(model.standard_parameters().allFinite(), "finite standard parameters");
   require(model.gravity.allFinite(), "finite gravity");
   require(model.transmission.N.rows() == n && model.transmission.N.cols() == n &&
