@@ -1,7 +1,7 @@
 // libFuzzer harness for the CLI argument layer: the input is split at newlines into argv (after
-// "dynid"), parsed by CLI11 with the real subcommand definitions (apps/dynid/cmd_*.cpp). The
-// subcommand callbacks are replaced by no-ops, so the harness covers flag parsing, type
-// conversion and option checks, not the computations (those go through the built binary in
+// "dynid"), parsed by CLI11 with the real subcommand definitions (apps/dynid/cmd_*.cpp). The parse
+// stops before the subcommand callbacks, so the harness covers flag parsing, type conversion and
+// option checks, not the computations (those go through the built binary in
 // tests/cli/cli_fuzz_test.cpp). Clean outcomes are the ones main.cpp maps to an exit code:
 // success, --help/--version, CLI::ParseError and dynid::Error.
 
@@ -14,6 +14,11 @@
 
 #include "commands.hpp"
 #include "fuzz_support.hpp"
+
+namespace {
+/// Thrown by a subcommand's parse-complete callback: the command line parsed and validated.
+struct ParseComplete {};
+}  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::vector<std::string> words{"dynid"};
@@ -44,8 +49,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   dynid::cli::add_excite_command(app);
   dynid::cli::add_simulate_command(app);
   dynid::cli::add_demo_command(app);
+  // The computations stay out: once a subcommand's flags are converted and its requirements
+  // checked, its parse-complete callback ends the parse before the command callback could run.
+  // (Replacing the command callback instead would free the options it owns while CLI11 still
+  // writes to them.)
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
-    sub->callback([] {});
+    sub->parse_complete_callback([] { throw ParseComplete{}; });
   }
   dynid::fuzz::expect_clean([&] {
     try {
@@ -55,6 +64,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       app.exit(e, out, err);
     } catch (const CLI::ParseError&) {
       // Clean: main() prints it as a usage error (exit 2).
+    } catch (const ParseComplete&) {
+      // Clean: the command line is valid.
     }
   });
   return 0;
