@@ -37,15 +37,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-// AddressSanitizer reserves terabytes of address space, so the memory limit of the runs is only
-// set in ordinary builds.
-#if defined(__SANITIZE_ADDRESS__)
-#define DYNID_UNDER_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define DYNID_UNDER_ASAN 1
-#endif
-#endif
+#include "support/asan.hpp"
 
 namespace dynid {
 namespace {
@@ -88,8 +80,9 @@ Outcome run_binary(const std::vector<std::string>& args, const fs::path& dir) {
     ::dup2(in, 0);
     ::dup2(out, 1);
     ::dup2(err, 2);
-#ifndef DYNID_UNDER_ASAN
-    // A memory blow-up should end as bad_alloc in the run, not in the machine's swap.
+#if !DYNID_UNDER_ASAN
+    // A memory blow-up should end as bad_alloc in the run, not in the machine's swap;
+    // AddressSanitizer reserves terabytes of address space, so not under it.
     const rlimit limit{4ul << 30, 4ul << 30};
     ::setrlimit(RLIMIT_AS, &limit);
 #endif
