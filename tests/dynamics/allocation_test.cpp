@@ -12,13 +12,14 @@
 #include "dynid/model/robots.hpp"
 #include "dynid/regressor/energy_regressor.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
+#include "support/asan.hpp"
 
 namespace {
 std::atomic<long> g_allocations{0};
 }  // namespace
 
 // AddressSanitizer replaces operator new itself, so the count is only taken without it.
-#if defined(__SANITIZE_ADDRESS__)
+#if DYNID_UNDER_ASAN
 #define DYNID_COUNT_ALLOCATIONS 0
 #else
 #define DYNID_COUNT_ALLOCATIONS 1
