@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <string>
+#include <vector>
 
 #include <Eigen/Dense>
 #include <Eigen/SVD>
@@ -51,12 +53,59 @@ void fill_parameter_statistics(Estimate& e, const EstimationOptions& options) {
   }
   e.t_quantile =
       e.degrees_of_freedom > 0 ? student_t_quantile(level, double(e.degrees_of_freedom)) : nan;
+  e.critical_value = e.t_quantile;
   e.ci_lower = e.x - e.t_quantile * e.std_dev;
   e.ci_upper = e.x + e.t_quantile * e.std_dev;
   e.poorly_excited.clear();
   for (Eigen::Index j = 0; j < p; ++j) {
     if (e.relative_std_percent(j) > options.poorly_excited_percent) e.poorly_excited.push_back(j);
   }
+}
+
+double fixed_b_critical_value(double level, double b) {
+  if (!(level > 0.0 && level < 1.0)) {
+    throw Error("confidence level " + std::to_string(level) +
+                " is outside (0, 1); pass a level such as 0.95 or 0.999");
+  }
+  if (!(b >= 0.0 && b <= 1.0)) {
+    throw Error("fixed-b fraction " + std::to_string(b) +
+                " is outside [0, 1]; pass (bandwidth + 1)/samples");
+  }
+  constexpr int kSteps = 1000, kDraws = 2000;
+  const int M = std::max(1, static_cast<int>(std::lround(b * kSteps)));
+  // Own Box–Muller on mt19937_64 (whose output the standard fixes): the same values everywhere.
+  std::mt19937_64 rng(20050601);
+  const double two_pi = 2.0 * std::acos(-1.0), scale = 1.0 / 18446744073709551616.0;
+  auto uniform = [&] { return (static_cast<double>(rng()) + 0.5) * scale; };
+  std::vector<double> q(kDraws);
+  Eigen::VectorXd u(kSteps), S(kSteps);
+  for (int r = 0; r < kDraws; ++r) {
+    for (int t = 0; t < kSteps; t += 2) {
+      const double rad = std::sqrt(-2.0 * std::log(uniform())), ang = two_pi * uniform();
+      u(t) = rad * std::cos(ang);
+      if (t + 1 < kSteps) u(t + 1) = rad * std::sin(ang);
+    }
+    u.array() -= u.mean();
+    double acc = 0.0;
+    for (int t = 0; t < kSteps; ++t) S(t) = acc += u(t);
+    // Σ_{t,s} u_t u_s (1 − |t−s|/M)₊ = (2/M)[Σ S_t² − Σ S_t S_{t+M}] with S_T = 0 (summation by
+    // parts twice: the second difference of the Bartlett weights is 2/M at 0, −1/M at ±M).
+    double sum = S.head(kSteps - 1).squaredNorm();
+    if (M < kSteps - 1) sum -= S.head(kSteps - 1 - M).dot(S.segment(M, kSteps - 1 - M));
+    q[r] = 2.0 / M * sum / kSteps;
+  }
+  auto coverage = [&](double c) {
+    double acc = 0.0;
+    for (double v : q) acc += std::erf(c * std::sqrt(std::max(v, 0.0)) / std::sqrt(2.0));
+    return acc / kDraws;
+  };
+  double lo = 0.0, hi = 1.0;
+  while (coverage(hi) < level && hi < 1e6) hi *= 2.0;
+  for (int it = 0; it < 80; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (coverage(mid) < level ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
 }
 
 namespace {
@@ -127,9 +176,13 @@ HacSummary apply_hac_covariance(Estimate& e, const Eigen::Ref<const Eigen::Matri
   }
   const Eigen::Index Tv = G.rows();
   double lag1 = 0.0;
-  const int L = options.bandwidth >= 0
-                    ? static_cast<int>(std::min<Eigen::Index>(options.bandwidth, Tv - 1))
-                    : andrews_bandwidth(G, lag1);
+  int L = options.bandwidth >= 0
+              ? static_cast<int>(std::min<Eigen::Index>(options.bandwidth, Tv - 1))
+              : andrews_bandwidth(G, lag1);
+  if (options.bandwidth < 0) {
+    const double floor_lags = std::ceil(options.min_bandwidth_fraction * Tv) - 1.0;
+    L = std::max(L, static_cast<int>(std::min(floor_lags, std::floor((Tv - 1) / 4.0))));
+  }
   out.score_lag1 = lag1;
   out.bandwidth = L;
   Eigen::MatrixXd S = G.transpose() * G;
@@ -153,6 +206,16 @@ HacSummary apply_hac_covariance(Estimate& e, const Eigen::Ref<const Eigen::Matri
   e.ci_lower_white = e.x - e.t_quantile * white;
   e.ci_upper_white = e.x + e.t_quantile * white;
   e.covariance_kind = "hac_bartlett";
+  out.b = std::min(1.0, (L + 1.0) / static_cast<double>(Tv));
+  if (options.fixed_b) {
+    // The fixed-b value is the N(0,1)-based limit; never below the Student-t quantile, which
+    // already allows for estimating σ² from m − r degrees of freedom.
+    e.critical_value =
+        std::max(e.t_quantile, fixed_b_critical_value(estimation_options.confidence_level, out.b));
+    e.ci_lower = e.x - e.critical_value * e.std_dev;
+    e.ci_upper = e.x + e.critical_value * e.std_dev;
+  }
+  out.critical_value = e.critical_value;
   std::vector<double> ratio;
   for (Eigen::Index j = 0; j < p; ++j) {
     if (white(j) > 0.0 && std::isfinite(white(j))) ratio.push_back(e.std_dev(j) / white(j));

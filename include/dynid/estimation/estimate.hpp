@@ -63,8 +63,11 @@ struct Estimate {
   Eigen::VectorXd relative_std_percent;  ///< 100·σ_x/|x| (+inf when x = 0)
   double confidence_level = 0.0;         ///< level of the intervals below
   double t_quantile = 0.0;               ///< Student-t quantile t with P(|T| ≤ t) = level
-  Eigen::VectorXd ci_lower;              ///< x − t·σ_x
-  Eigen::VectorXd ci_upper;              ///< x + t·σ_x
+  /// Half-width multiplier c of ci_lower/ci_upper: t_quantile for the white covariance, the
+  /// fixed-b critical value for a HAC one (fixed_b_critical_value).
+  double critical_value = 0.0;
+  Eigen::VectorXd ci_lower;  ///< x − c·σ_x
+  Eigen::VectorXd ci_upper;  ///< x + c·σ_x
   /// σ_x of the white-noise covariance σ²·(WᵀW)⁻¹ when `covariance` was replaced by a sandwich
   /// (apply_hac_covariance); else empty. Too narrow when the residuals are correlated.
   Eigen::VectorXd std_dev_white;

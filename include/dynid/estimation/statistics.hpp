@@ -27,14 +27,34 @@ struct HacOptions {
   /// Andrews–Monahan (1992) VAR(1) pre-whitening of the scores before the Bartlett window, then
   /// recolouring: removes most of the kernel's downward bias under strong autocorrelation.
   bool prewhiten = true;
+  /// Smallest automatic window as a fraction b = (bandwidth + 1)/samples: the Andrews rule targets
+  /// the variance's mean-squared error, not coverage, and picks a few lags on pre-whitened scores;
+  /// 0.02 is the smallest round fraction that reached the level under white, AR(1) and
+  /// unmodelled-term residuals (docs/methods/estimation.md §5). Ignored for a given bandwidth.
+  double min_bandwidth_fraction = 0.02;
+  /// Half-widths from the fixed-b critical value of the Bartlett HAC t-statistic
+  /// (fixed_b_critical_value) instead of the Student-t quantile: the HAC variance is itself noisy.
+  bool fixed_b = true;
 };
 
 /// What apply_hac_covariance found.
 struct HacSummary {
-  int bandwidth = 0;          ///< Bartlett lags used
-  double score_lag1 = 0.0;    ///< weighted mean lag-1 autocorrelation of the per-sample scores
-  double median_ratio = 1.0;  ///< median over parameters of std_dev / std_dev_white
+  int bandwidth = 0;            ///< Bartlett lags used
+  double score_lag1 = 0.0;      ///< weighted mean lag-1 autocorrelation of the per-sample scores
+  double median_ratio = 1.0;    ///< median over parameters of std_dev / std_dev_white
+  double b = 0.0;               ///< (bandwidth + 1)/samples, the fixed-b fraction
+  double critical_value = 0.0;  ///< half-width multiplier of the HAC intervals
 };
+
+/// Two-sided fixed-b critical value c of the Bartlett-kernel HAC t-statistic: P(|t| ≤ c) = level
+/// under the Kiefer–Vogelsang limit t = Z/√Q(b), Z ~ N(0,1) independent of Q(b), the Bartlett
+/// long-run-variance functional of a Brownian bridge with window b (fraction of the sample).
+/// Q is drawn by a fixed-seed simulation (1000 steps, 2000 draws, exact partial-sum form of the
+/// Bartlett sum) and c solved from mean(erf(c·√Q/√2)) = level, which holds for any level.
+/// c → the normal quantile as b → 0. Kiefer & Vogelsang (2005), Econometric Theory 21 (their
+/// cubic cv(b) tables are the test oracle); derivation in docs/methods/estimation.md §5.
+/// Throws dynid::Error if level ∉ (0, 1) or b ∉ [0, 1].
+double fixed_b_critical_value(double level, double b);
 
 /// Replaces the white-noise covariance of `estimate` by the Newey–West (HAC) sandwich
 /// C = m/(m−r) · B·S·B with bread B = (WᵀW)⁻¹ = covariance/σ² (the estimator's own, so the
@@ -43,11 +63,12 @@ struct HacSummary {
 /// of sample k (their residuals are correlated across joints too). With options.prewhiten the
 /// window runs on v_k = g_k − A·g_{k−1} (A the least-squares VAR(1) of the scores, singular
 /// values capped at 0.97) and S = (I − A)⁻¹ S_v (I − A)⁻ᵀ. Keeps the white statistics in
-/// std_dev_white / ci_*_white and refills std_dev, the intervals (same Student-t quantile) and
-/// the poorly-excited list. W (m×p) and e (m) must be the rows the estimator solved (weighted for
-/// WLS); sample (m entries, ≥ 0, non-decreasing) gives the time index of each row, gaps allowed.
-/// Newey & West (1987), Andrews (1991); derivation in docs/methods/estimation.md.
-/// Throws dynid::Error for size mismatches or a decreasing sample index.
+/// std_dev_white / ci_*_white (Student-t quantile) and refills std_dev, the intervals (half-width
+/// critical_value·std_dev, the fixed-b value with options.fixed_b) and the poorly-excited list. W
+/// (m×p) and e (m) must be the rows the estimator solved (weighted for WLS); sample (m entries, ≥
+/// 0, non-decreasing) gives the time index of each row, gaps allowed. Newey & West (1987), Andrews
+/// (1991); derivation in docs/methods/estimation.md. Throws dynid::Error for size mismatches or a
+/// decreasing sample index.
 HacSummary apply_hac_covariance(Estimate& estimate, const Eigen::Ref<const Eigen::MatrixXd>& W,
                                 const Eigen::Ref<const Eigen::VectorXd>& e,
                                 const Eigen::Ref<const Eigen::VectorXi>& sample,
