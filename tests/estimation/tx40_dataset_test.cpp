@@ -91,7 +91,14 @@ TEST_F(Tx40Dataset, ValidationOnTheSameRunReproducesTheIdentificationError) {
   for (int j = 0; j < 6; ++j) {
     EXPECT_NEAR(validation_->rms[j], result_->residual_rms[j], 1e-9 * result_->residual_rms[j]);
   }
-  EXPECT_GT(validation_->relative_error_all_rows, 2.0 * validation_->relative_error_all);
+  // The rows identify left out (near-still: friction sits on the Coulomb step there) are
+  // predicted worse than the kept ones, so the all-rows figure is larger; the filtered
+  // expected-sign Coulomb columns keep it within 2× (7.99 % vs 4.94 %; the hard sign(q̇) columns
+  // gave more than 2×). Fails if the left-out rows stop being reported or the slow-row model
+  // regresses.
+  EXPECT_GT(validation_->rows_excluded, 0);
+  EXPECT_GT(validation_->relative_error_all_rows, validation_->relative_error_all);
+  EXPECT_LT(validation_->relative_error_all_rows, 2.0 * validation_->relative_error_all);
 }
 
 TEST_F(Tx40Dataset, FrictionMatchesPublishedValues) {
