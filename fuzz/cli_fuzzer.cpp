@@ -42,13 +42,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   app.set_version_flag("--version", std::string("dynid"), "Print the version and exit");
   app.require_subcommand(1, 1);
   app.fallthrough(false);
-  dynid::cli::add_model_command(app);
-  dynid::cli::add_inverse_dynamics_command(app);
-  dynid::cli::add_identify_command(app);
-  dynid::cli::add_validate_command(app);
-  dynid::cli::add_excite_command(app);
-  dynid::cli::add_simulate_command(app);
-  dynid::cli::add_demo_command(app);
+  dynid::cli::add_commands(app);
   // The computations stay out: once a subcommand's flags are converted and its requirements
   // checked, its parse-complete callback ends the parse before the command callback could run.
   // (Replacing the command callback instead would free the options it owns while CLI11 still

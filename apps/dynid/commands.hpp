@@ -7,6 +7,10 @@
 
 namespace dynid::cli {
 
+/// Registers every subcommand below on `app` and the NaN/Inf check of their numeric flags
+/// (flag_checks.hpp): the one definition of the command line, used by main() and the CLI fuzzer.
+void add_commands(CLI::App& app);
+
 /// `dynid model`: robot summary and JSON export (cmd_model.cpp).
 void add_model_command(CLI::App& app);
 

@@ -15,7 +15,6 @@
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
 #include "dynid/version.hpp"
-#include "flag_checks.hpp"
 
 namespace {
 
@@ -47,14 +46,7 @@ int main(int argc, char** argv) {
                        "Print the version and exit");
   app.require_subcommand(1, 1);
   app.fallthrough(false);
-  dynid::cli::add_model_command(app);
-  dynid::cli::add_inverse_dynamics_command(app);
-  dynid::cli::add_identify_command(app);
-  dynid::cli::add_validate_command(app);
-  dynid::cli::add_excite_command(app);
-  dynid::cli::add_simulate_command(app);
-  dynid::cli::add_demo_command(app);
-  dynid::cli::check_numeric_flags(app);
+  dynid::cli::add_commands(app);
   try {
     if (const std::string unknown = unknown_command(app, argc, argv); !unknown.empty()) {
       return fail(2, unknown);

@@ -1,0 +1,19 @@
+// add_commands(): the one list of dynid's subcommands (main.cpp and fuzz/cli_fuzzer.cpp).
+#include "commands.hpp"
+
+#include "flag_checks.hpp"
+
+namespace dynid::cli {
+
+void add_commands(CLI::App& app) {
+  add_model_command(app);
+  add_inverse_dynamics_command(app);
+  add_identify_command(app);
+  add_validate_command(app);
+  add_excite_command(app);
+  add_simulate_command(app);
+  add_demo_command(app);
+  check_numeric_flags(app);
+}
+
+}  // namespace dynid::cli
