@@ -230,7 +230,7 @@ void add_signal_flags(CLI::App* cmd, IdentifyCliOptions& o) {
       ->capture_default_str();
   cmd->add_option("--cutoff", o.cutoff,
                   "Filter cut-off [Hz], or auto (= 0, default): 1.5 x the highest frequency where "
-                  "the position spectrum stands 10 dB above its noise floor, in [1 Hz, min(20 Hz, "
+                  "the position spectrum stands 20 dB above its noise floor, in [1 Hz, min(20 Hz, "
                   "rate/10)]")
       ->transform(CLI::Transformer(std::map<std::string, std::string>{{"auto", "0"}}));
   cmd->add_option("--decimate", o.decimate,
