@@ -89,14 +89,15 @@ RunFileOptions run_file_options(const std::string& columns, double rate,
 // One line per processing choice on stderr (the result JSON keeps them under `choices`).
 void echo_choices(const char* command, const RunFileReport& read,
                   const std::vector<std::pair<std::string, std::string>>& choices) {
-  for (const auto& w : read.warnings) std::cerr << "warning: " << w << '\n';
-  for (const auto& note : read.notes) std::cerr << command << ": " << note << '\n';
+  // Choices quote input (file names): one_line() keeps each of them on one printable line.
+  for (const auto& w : read.warnings) std::cerr << "warning: " << one_line(w) << '\n';
+  for (const auto& note : read.notes) std::cerr << command << ": " << one_line(note) << '\n';
   for (const auto& [key, value] : choices)
-    std::cerr << command << ": " << key << ": " << value << '\n';
+    std::cerr << command << ": " << key << ": " << one_line(value) << '\n';
 }
 
 void warn(const std::string& text) {
-  std::cerr << "warning: " << text << '\n';
+  std::cerr << "warning: " << one_line(text) << '\n';
 }
 
 std::vector<std::string> split(const std::string& text, char sep) {

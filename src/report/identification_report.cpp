@@ -121,7 +121,7 @@ std::string identification_table(const Model& model, const IdentificationResult&
     s << line("  %-*s residual RMS %.4g, relative error %.2f %%\n", w, model.joints[j].name.c_str(),
               r.residual_rms[j], 100 * r.joint_relative_error[j]);
   }
-  for (const auto& w : r.warnings) s << "warning: " << w << '\n';
+  for (const auto& w : r.warnings) s << "warning: " << one_line(w) << '\n';
   return s.str();
 }
 

@@ -2,7 +2,8 @@
 // flag values go through every command of the built binary (compile definition DYNID_BINARY), and
 // every run must keep the error contract of docs/cli.md:
 // - it ends by itself (no signal, no hang: a generous per-run limit, not a speed check);
-// - exit 0, or exit 1 / 2 with exactly one line on stderr that starts with "error: ";
+// - exit 0, or exit 1 / 2 with stderr ending in the one line that starts with "error: " (after the
+//   command's echo of its choices and warnings, if any: testing::error_contract_problem);
 // - stderr is valid UTF-8 without control characters (besides the line ends);
 // - a failed run leaves nothing in its output folder (no partial file, no temporary);
 // - a successful run writes no non-finite number: every CSV field parses as a finite number, and a
@@ -38,6 +39,7 @@
 #include <nlohmann/json.hpp>
 
 #include "support/asan.hpp"
+#include "support/cli_run.hpp"
 
 namespace dynid {
 namespace {
@@ -48,12 +50,8 @@ namespace fs = std::filesystem;
 // --max-time 1), so that only a run that does not end by itself reaches it.
 constexpr int kRunLimitSeconds = 120;
 
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using dynid::testing::error_contract_problem;
+using dynid::testing::slurp;
 
 void write_file(const fs::path& path, const std::string& text) {
   std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
@@ -258,10 +256,8 @@ std::vector<std::string> contract_problems(const Outcome& o, const fs::path& out
       }
     }
   } else if (o.code > 0) {
-    const auto lines = std::count(o.err.begin(), o.err.end(), '\n');
-    if (o.err.rfind("error: ", 0) != 0 || lines != 1 || o.err.back() != '\n') {
-      p.push_back("stderr is not exactly one line starting with 'error: ' (" +
-                  std::to_string(lines) + " lines)");
+    if (const std::string problem = error_contract_problem(o.err); !problem.empty()) {
+      p.push_back(problem);
     }
     for (const auto& f : files) {
       p.push_back("failed run left " + fs::relative(f, out_dir.parent_path()).string());
@@ -718,7 +714,7 @@ TEST_F(CliFuzz, Simulate) {
          {"--position-noise", {"0.0001", "0"}},
          {"--torque-noise", {"0.01", "0"}},
          {"--counts-per-rev", {"4096"}},
-         {"--delay", {"1", "0"}},
+         {"--delay", {"0", "1"}},
          {"--truth", {}}},
         {"ref.csv", "planar2.yaml"},
         30},

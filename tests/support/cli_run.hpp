@@ -41,4 +41,30 @@ inline CliResult run_dynid(const std::string& args, const std::filesystem::path&
   return r;
 }
 
+/// What breaks the error contract of docs/cli.md in the stderr of a failed run, or "" when it
+/// holds: the last line is the one line that starts with "error: "; the lines before it may only be
+/// the command's echo of its choices ("identify: …") and warnings ("warning: …"); no line has a
+/// control character.
+inline std::string error_contract_problem(const std::string& err) {
+  if (err.empty() || err.back() != '\n') return "stderr does not end with a line end";
+  std::istringstream lines(err);
+  std::string line, last;
+  int errors = 0;
+  while (std::getline(lines, line)) {
+    for (const char ch : line) {
+      const auto c = static_cast<unsigned char>(ch);
+      if (c < 0x20 || c == 0x7F) return "control character in stderr line: " + line;
+    }
+    if (line.rfind("error: ", 0) == 0) {
+      ++errors;
+    } else if (line.rfind("warning: ", 0) != 0 && line.find(": ") == std::string::npos) {
+      return "stderr line is neither an echo, a warning nor the error: " + line;
+    }
+    last = line;
+  }
+  if (errors != 1) return "stderr has " + std::to_string(errors) + " lines starting with 'error: '";
+  if (last.rfind("error: ", 0) != 0) return "the error is not the last line of stderr";
+  return {};
+}
+
 }  // namespace dynid::testing
