@@ -18,7 +18,9 @@ struct CsvChunkReader::Impl {
   std::size_t pos = 0;     // start of unread text in buffer
   std::size_t filled = 0;  // end of valid text in buffer
   bool eof = false;
-  char eol = '\n';  // line terminator, detected from the first buffer (csv_detail::detect_eol)
+  // Line terminator (csv_detail::detect_eol), 0 until the file's first line end has been read:
+  // it may lie beyond the first buffer, and the in-memory reader decides on the same line end.
+  char eol = 0;
   long line = 0;
   Eigen::Index rows = 0;
   std::vector<std::string> columns;
@@ -33,7 +35,14 @@ struct CsvChunkReader::Impl {
     while (true) {
       char* start = buffer.data() + pos;
       const std::size_t avail = filled - pos;
-      char* nl = static_cast<char*>(std::memchr(start, eol, avail));
+      if (eol == 0) {
+        const char* end = start + avail;
+        const char* p = start;
+        while (p < end && *p != '\n' && *p != '\r') ++p;
+        // A CR at the end of the buffer may be the first half of a CRLF: read on to decide.
+        if (p < end && (*p == '\n' || p + 1 < end || eof)) eol = csv_detail::detect_eol(start, end);
+      }
+      char* nl = eol == 0 ? nullptr : static_cast<char*>(std::memchr(start, eol, avail));
       if (static_cast<std::size_t>(
               (nl != nullptr ? nl - start : static_cast<std::ptrdiff_t>(avail))) >
           kMaxCsvLineBytes) {
@@ -87,7 +96,7 @@ CsvChunkReader::CsvChunkReader(const std::string& path, const CsvChunkOptions& o
     throw Error(path + ": cannot open (" + std::strerror(errno) +
                 "); check the path given to --in");
   }
-  // First read: skip a byte-order mark and learn the line terminator.
+  // First read: skip a byte-order mark (the line terminator is learnt by next_line).
   Impl& s = *impl_;
   s.filled = std::fread(s.buffer.data(), 1, s.buffer.size(), s.file);
   if (s.filled < s.buffer.size()) {
@@ -97,7 +106,6 @@ CsvChunkReader::CsvChunkReader(const std::string& path, const CsvChunkOptions& o
     s.eof = true;
   }
   s.pos = csv_detail::bom_length(s.buffer.data(), s.buffer.data() + s.filled);
-  s.eol = csv_detail::detect_eol(s.buffer.data() + s.pos, s.buffer.data() + s.filled);
   const char* b = nullptr;
   const char* e = nullptr;
   bool terminated = true;

@@ -99,5 +99,30 @@ TEST(CsvChunkReader, ByteOrderMarkCrOnlyAndLineLimit) {
   EXPECT_HAS(m, "/dev/zero:1: line is longer than 1 MiB");
 }
 
+// Found by fuzz/csv_fuzzer: the streaming reader learnt the line terminator from its first buffer
+// only, so a CR-only file whose first line end lies beyond it was read as one line, while
+// read_csv() (the oracle here) saw 3 rows. Same terminator, same table, any buffer size.
+TEST(CsvChunkReader, LineEndBeyondTheFirstBufferIsTheOneReadCsvSees) {
+  TempDir dir;
+  const std::string header = "t," + std::string(100, 'q') + "1";
+  for (const std::string eol : {"\r", "\r\n", "\n"}) {
+    const std::string path =
+        dir.write("late.csv", header + eol + "0,1" + eol + "0.5,2" + eol + "1,3" + eol);
+    const CsvTable table = read_csv(path);
+    for (const std::size_t bytes : {std::size_t{64}, header.size(), header.size() + 1}) {
+      CsvChunkOptions options;
+      options.buffer_bytes = bytes;  // the first buffer ends before, on or after the first CR
+      CsvChunkReader reader(path, options);
+      EXPECT_EQ(reader.columns(), table.columns) << bytes;
+      Eigen::MatrixXd block, all(0, 2);
+      while (reader.next(block)) {
+        all.conservativeResize(all.rows() + block.rows(), 2);
+        all.bottomRows(block.rows()) = block;
+      }
+      EXPECT_EQ(all, table.data) << "buffer " << bytes << " bytes, eol " << eol.size();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace dynid
