@@ -281,7 +281,11 @@ void run_identify(const IdentifyCliOptions& o, const CLI::App& cmd) {
                : identify(model, read_joint_record(o.data, model, file, &read), options);
   echo_choices("identify", read, result.choices);
   std::cout << identification_table(model, result);
-  write_json(o.out, identification_to_json(model, result, echo(o)));
+  // Record the Coulomb columns identify actually used (the automatic zero-velocity rule turns the
+  // filtered expected-sign columns on), so that validate rebuilds the same regressor.
+  nlohmann::json used = echo(o);
+  used["filter_coulomb_columns"] = result.processed.moving_positive.size() != 0;
+  write_json(o.out, identification_to_json(model, result, used));
   std::cout << "wrote " << o.out << '\n';
 }
 

@@ -312,8 +312,9 @@ constexpr double kCorrelatedResidualWarning = 0.5;
 
 // Rows of joint j where |dq_j| is below threshold_j, too small for sign(dq_j) to be meaningful, are
 // left out when the layout has Coulomb friction: given values (1 or n), or by default
-// zero_velocity_noise_multiple × the processed velocity's noise std (where the sign of dq is not
-// known from the data). Zero without Coulomb friction. The choice is appended to `choices`.
+// max(zero_velocity_fraction × max|dq_j|, zero_velocity_noise_multiple × the processed velocity's
+// noise std): the band where real friction leaves the Coulomb law, or where the sign of dq is not
+// known from the data. Zero without Coulomb friction. The choice is appended to `choices`.
 Eigen::VectorXd zero_velocity_threshold(const IdentifyOptions& options,
                                         const ProcessedRecord& processed, const char* verb,
                                         std::vector<std::pair<std::string, std::string>>& choices) {
