@@ -1,0 +1,126 @@
+// Friction experiment (seed 2 §3.2.2, eq. 2, Table 2): bang-bang moves of one joint of planar2 in
+// closed loop on the native plant (RK4, tanh-smoothed Coulomb friction plus an offset, so that the
+// Coulomb level differs by direction: Fcp = Fc + Fo, Fcn = Fc − Fo), with encoder and torque noise,
+// prepared by preprocess() with its defaults; inertia and gravity compensated with the plant's
+// model. Fixed seeds.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "dynid/common/error.hpp"
+#include "dynid/estimation/friction_experiment.hpp"
+#include "dynid/excitation/bang_bang_trajectory.hpp"
+#include "dynid/excitation/trajectory_samples.hpp"
+#include "dynid/model/robots.hpp"
+#include "dynid/sim/simulate_reference.hpp"
+
+namespace dynid {
+namespace {
+
+constexpr double kRate = 200.0;
+
+Model plant_model() {
+  Model m = load_robot("planar2");
+  m.joints[0].friction = {0.0, 1.5, 2.0, 0.4};
+  m.joints[1].friction = {0.0, 0.8, 1.0, -0.2};
+  return m;
+}
+
+ProcessedRecord bang_bang_run(const Model& m, int joint, unsigned seed) {
+  Eigen::MatrixXd wp(2, 3);
+  wp.setConstant(0.4);
+  wp(joint, 0) = -1.0;
+  wp(joint, 1) = 1.0;
+  wp(joint, 2) = -1.0;
+  const TrajectorySamples tr =
+      sample_trajectory(BangBangTrajectory(wp, Eigen::Vector2d::Constant(4.0), 0.2), kRate, false);
+  SimulateOptions so;
+  so.sensors.position_noise_std = 1e-4;
+  so.sensors.torque_noise_std = 0.05;
+  so.sensors.seed = seed;
+  so.loop.periods = 4;
+  const ClosedLoopResult run = simulate_reference(m, tr.t, tr.q, tr.dq, tr.ddq, so);
+  const Eigen::Index skip = tr.t.size(), rows = run.t.size() - skip;  // start-up period
+  const JointRecord record{
+      run.t.tail(rows), run.q.bottomRows(rows), {}, {}, run.tau.bottomRows(rows)};
+  std::vector<std::pair<std::string, std::string>> choices;
+  SignalOptions signal;
+  signal.torque_time_offset = 0.5 / kRate;  // the logged command is held over the next step
+  return preprocess(record, signal, choices);
+}
+
+Eigen::Vector4d truth(const JointFriction& f) {
+  return Eigen::Vector4d(f.Fv, f.Fv, f.Fc + f.Fo, f.Fc - f.Fo);
+}
+
+TEST(FrictionExperiment, RecoversAsymmetricFrictionInsideItsIntervals) {
+  const Model m = plant_model();
+  for (int joint : {0, 1}) {
+    for (unsigned seed : {1u, 2u}) {
+      SCOPED_TRACE("joint " + std::to_string(joint + 1) + ", seed " + std::to_string(seed));
+      const FrictionExperimentResult r =
+          fit_friction_experiment(m, {bang_bang_run(m, joint, seed)}, joint);
+      const Eigen::Vector4d t = truth(m.joints[joint].friction);
+      for (int i = 0; i < 4; ++i) {
+        EXPECT_LE(r.estimate.ci_lower[i], t[i]) << r.names[i] << " = " << r.estimate.x[i];
+        EXPECT_GE(r.estimate.ci_upper[i], t[i]) << r.names[i] << " = " << r.estimate.x[i];
+        // Informative, not merely wide.
+        EXPECT_LT(r.estimate.ci_upper[i] - r.estimate.x[i], 0.2 * t[i]) << r.names[i];
+      }
+      EXPECT_EQ(r.names[0], "Fvp" + std::to_string(joint + 1));
+      EXPECT_GT(r.rows_left_out, 0);
+      // The curve passes through the fit at the peak speed.
+      EXPECT_NEAR(r.curve_torque[r.curve_torque.size() - 1],
+                  r.estimate.x[0] * r.curve_velocity.maxCoeff() + r.estimate.x[2], 1e-9);
+    }
+  }
+}
+
+TEST(FrictionExperiment, AWrongCompensationModelShowsInTheFriction) {
+  // Negative control: compensating with link masses 30 % high leaves gravity and inertia torque in
+  // τ_f. The estimates are then far off, and the result must say so: a large relative error, a
+  // warning, and HAC intervals much wider than the white ones (the residual is not noise).
+  const Model m = plant_model();
+  Model wrong = m;
+  for (auto& link : wrong.links) link *= 1.3;
+  const FrictionExperimentResult r = fit_friction_experiment(wrong, {bang_bang_run(m, 0, 1)}, 0);
+  const Eigen::Vector4d t = truth(m.joints[0].friction);
+  int far = 0;
+  for (int i = 0; i < 4; ++i) far += std::abs(r.estimate.x[i] - t[i]) > 0.5 * t[i];
+  EXPECT_GE(far, 2);
+  EXPECT_GT(r.relative_error, 0.2);
+  ASSERT_FALSE(r.warnings.empty());
+  EXPECT_NE(r.warnings.front().find("not explained by friction"), std::string::npos);
+  for (int i = 0; i < 4; ++i) EXPECT_GT(r.estimate.std_dev[i], 5.0 * r.estimate.std_dev_white[i]);
+}
+
+TEST(FrictionExperiment, OneDirectionOnlyIsRefused) {
+  const Model m = plant_model();
+  const ProcessedRecord full = bang_bang_run(m, 1, 1);
+  std::vector<Eigen::Index> up;
+  for (Eigen::Index k = 0; k < full.record.t.size(); ++k)
+    if (full.record.dq(k, 1) >= 0.0) up.push_back(k);
+  ProcessedRecord p = full;
+  auto rows = [&](const Eigen::MatrixXd& x) {
+    Eigen::MatrixXd out(static_cast<Eigen::Index>(up.size()), x.cols());
+    for (size_t i = 0; i < up.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = x.row(up[i]);
+    return out;
+  };
+  p.record.t = rows(full.record.t);
+  p.record.q = rows(full.record.q);
+  p.record.dq = rows(full.record.dq);
+  p.record.ddq = rows(full.record.ddq);
+  p.record.tau = rows(full.record.tau);
+  p.moving_positive = rows(full.moving_positive);
+  p.moving_negative = rows(full.moving_negative);
+  try {
+    fit_friction_experiment(m, {p}, 1);
+    FAIL() << "one direction was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("both directions"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(fit_friction_experiment(m, {full}, 2), UsageError);
+}
+
+}  // namespace
+}  // namespace dynid
