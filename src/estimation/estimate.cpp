@@ -12,6 +12,8 @@ const char* to_string(EstimatorKind kind) {
       return "weighted_least_squares";
     case EstimatorKind::kRecursiveLeastSquares:
       return "recursive_least_squares";
+    case EstimatorKind::kMaximumLikelihood:
+      return "maximum_likelihood";
   }
   return "unknown";
 }

@@ -131,21 +131,22 @@ CutoffChoice choose_cutoff(const Eigen::Ref<const Eigen::MatrixXd>& q, double ra
 
 double white_noise_gain(const SosFilter* filter, int derivative, double rate_hz) {
   check_rate(rate_hz);
-  if (derivative != 0 && derivative != 1) {
-    throw Error("white_noise_gain: derivative " + std::to_string(derivative) + " is not 0 or 1");
+  if (derivative < 0 || derivative > 2) {
+    throw Error("white_noise_gain: derivative " + std::to_string(derivative) + " is not 0, 1 or 2");
   }
   // Long enough for the impulse response of a cut-off down to ~rate/2000 to decay.
   const Eigen::Index half = 8192;
   Eigen::MatrixXd h = Eigen::MatrixXd::Zero(2 * half + 1, 1);
   h(half, 0) = 1.0;
   if (filter != nullptr) h = filtfilt(*filter, h);
-  if (derivative == 0) return h.norm();
-  double sum = 0.0;
-  for (Eigen::Index k = 1; k + 1 < h.rows(); ++k) {
-    const double d = 0.5 * rate_hz * (h(k + 1, 0) - h(k - 1, 0));
-    sum += d * d;
+  // Central differences applied `derivative` times, as preprocess() derives q̇ and then q̈.
+  for (int d = 0; d < derivative; ++d) {
+    Eigen::MatrixXd dh = Eigen::MatrixXd::Zero(h.rows(), 1);
+    for (Eigen::Index k = 1; k + 1 < h.rows(); ++k)
+      dh(k, 0) = 0.5 * rate_hz * (h(k + 1, 0) - h(k - 1, 0));
+    h = std::move(dh);
   }
-  return std::sqrt(sum);
+  return h.norm();
 }
 
 }  // namespace dynid

@@ -11,7 +11,8 @@ namespace dynid {
 enum class EstimatorKind {
   kOrdinaryLeastSquares,  ///< QR least squares, one pass
   kWeightedLeastSquares,  ///< Gautier's two-step weighted least squares (per-group variances)
-  kRecursiveLeastSquares  ///< U-D-Uᵀ recursive least squares (seed 1 eqs. 36–37)
+  kRecursiveLeastSquares,  ///< U-D-Uᵀ recursive least squares (seed 1 eqs. 36–37)
+  kMaximumLikelihood       ///< errors in variables (seed 2 eqs. 13–16)
 };
 
 /// Lower-case name of an estimator kind ("ordinary_least_squares", ...), for reports and JSON.

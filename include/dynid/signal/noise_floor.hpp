@@ -66,9 +66,10 @@ CutoffChoice choose_cutoff(const Eigen::Ref<const Eigen::MatrixXd>& q, double ra
                            const CutoffRule& rule = {});
 
 /// Noise gain of a processing chain for white noise: σ_out / σ_in for the zero-phase filter
-/// (filtfilt; none when `filter` is null) followed by `derivative` (0 or 1) central differences at
-/// rate_hz, i.e. sqrt(Σ_k h_k²) for h the impulse response of the chain (computed numerically;
-/// units 1/s per derivative). Throws dynid::Error for a rate that is not > 0 or derivative ∉ {0,1}.
+/// (filtfilt; none when `filter` is null) followed by `derivative` (0, 1 or 2) passes of central
+/// differences at rate_hz, i.e. sqrt(Σ_k h_k²) for h the impulse response of the chain (computed
+/// numerically; units 1/s per derivative). Throws dynid::Error for a rate that is not > 0 or
+/// derivative ∉ {0, 1, 2}.
 double white_noise_gain(const SosFilter* filter, int derivative, double rate_hz);
 
 }  // namespace dynid

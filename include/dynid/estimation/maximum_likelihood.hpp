@@ -1,0 +1,77 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "dynid/estimation/equation_block.hpp"
+#include "dynid/estimation/estimate.hpp"
+#include "dynid/estimation/identification.hpp"
+#include "dynid/model/model.hpp"
+#include "dynid/regressor/parameter_layout.hpp"
+
+namespace dynid {
+
+/// Standard deviations of the measured variables of a differential block, per joint (seed 2
+/// eq. 16's σ²). q, dq, ddq [rad, rad/s, rad/s² or m, m/s, m/s²]: the noise on the signals the
+/// regressor is built from (after filtering and differentiation); an empty vector is noise-free.
+/// tau [N·m or N]: required, every entry > 0.
+struct MeasurementNoise {
+  Eigen::VectorXd q, dq, ddq, tau;
+};
+
+/// Options of maximum_likelihood() (Ceres style).
+struct MaximumLikelihoodOptions {
+  int max_iterations = 100;            ///< Levenberg–Marquardt iterations (Ceres)
+  double function_tolerance = 1e-12;   ///< relative cost change that ends the iterations
+  double parameter_tolerance = 1e-12;  ///< relative step that ends the iterations
+  /// Intervals from a Newey–West sandwich over samples on the whitened scores (as identify()'s
+  /// default), the information-based ones kept as std_dev_white; false: information only.
+  bool hac = true;
+};
+
+/// What the maximum-likelihood solve did (Ceres style).
+struct MaximumLikelihoodSummary {
+  int iterations = 0;         ///< Levenberg–Marquardt iterations
+  double initial_cost = 0.0;  ///< eq. 15 at the start
+  double final_cost = 0.0;    ///< eq. 15 at the estimate
+  bool converged = false;     ///< Ceres reported convergence
+  std::string termination;    ///< Ceres' message
+  /// 2·final_cost / (samples' rows − parameters): ≈ 1 when the noise standard deviations are
+  /// right; above 1, the noise was underestimated (or the model lacks a term).
+  double variance_factor = 0.0;
+};
+
+/// ∂W_i/∂(q, q̇, q̈) of every row i of a differential block, columns `columns` of the sample-major
+/// regressor of `processed` (processed_regressor()): rows 3n·i … 3n·i + 3n − 1 of the result are
+/// the derivatives of row i with respect to q_1…q_n, q̇_1…q̇_n, q̈_1…q̈_n of its sample, so that
+/// ∂(W_i·θ)/∂x = (that block)·θ (seed 2 eq. 16's B without the torque column). Row i is sample
+/// `sample[i]`, joint `joint[i]` of the record (a differential block's sample and group). By
+/// central differences of the regressor: exact for q̇ (W is quadratic in it) and q̈ (linear),
+/// O(h²) for q. Coulomb columns have no derivative (taken as given). Size (3n·rows) × columns.
+/// Throws dynid::Error for an index outside the record.
+Eigen::MatrixXd differential_sensitivity(const Model& model, const ParameterLayout& layout,
+                                         bool coupling, const ProcessedRecord& processed,
+                                         const std::vector<int>& columns,
+                                         const Eigen::VectorXi& sample,
+                                         const Eigen::VectorXi& joint);
+
+/// Maximum-likelihood estimate with errors in variables (seed 2 eqs. 13–16; Olsen 2003): minimises
+/// ½ Σ_k b_kᵀ S_k⁻¹ b_k over θ, b_k = τ_k − W_k·θ the rows of sample k, S_k = B_k σ² B_kᵀ with
+/// B_k = [∂(W_k θ)/∂(q, q̇, q̈), I] (eq. 16: the torque noise plus the noise of the variables the
+/// regressor is built from, propagated through the model). Solved by Levenberg–Marquardt (Ceres)
+/// from `start` (the OLS estimate). Covariance: σ_f²·F⁻¹, F = Σ_k W_kᵀ S_k⁻¹ W_k the information at
+/// the estimate and σ_f² the variance factor (≈ 1 when the noise is right), then by default a HAC
+/// sandwich over samples on the whitened rows (std_dev_white keeps σ_f²·F⁻¹). `block`: a
+/// differential block over the estimated columns (group = joint, sample = sample);
+/// `sensitivity`: differential_sensitivity() of the same rows and columns. Throws dynid::Error for
+/// sizes that do not match, a non-positive or non-finite torque noise, or a start that is not
+/// finite.
+Estimate maximum_likelihood(const EquationBlock& block, const Eigen::MatrixXd& sensitivity,
+                            const MeasurementNoise& noise, const Eigen::VectorXd& start,
+                            const EstimationOptions& estimation_options = {},
+                            const MaximumLikelihoodOptions& options = {},
+                            MaximumLikelihoodSummary* summary = nullptr);
+
+}  // namespace dynid

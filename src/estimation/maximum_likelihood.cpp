@@ -1,0 +1,254 @@
+#include "dynid/estimation/maximum_likelihood.hpp"
+
+#include <cmath>
+
+#include <ceres/ceres.h>
+#include <Eigen/Cholesky>
+
+#include "dynid/common/error.hpp"
+#include "dynid/estimation/least_squares.hpp"
+#include "dynid/estimation/statistics.hpp"
+
+namespace dynid {
+
+Eigen::MatrixXd differential_sensitivity(const Model& model, const ParameterLayout& layout,
+                                         bool coupling, const ProcessedRecord& processed,
+                                         const std::vector<int>& columns,
+                                         const Eigen::VectorXi& sample,
+                                         const Eigen::VectorXi& joint) {
+  const int n = model.dof();
+  const Eigen::Index m = processed.record.t.size();
+  const Eigen::Index rows = sample.size();
+  if (joint.size() != rows) {
+    throw Error("differential_sensitivity: " + std::to_string(rows) + " sample indices but " +
+                std::to_string(joint.size()) + " joint indices");
+  }
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    if (sample[i] < 0 || sample[i] >= m || joint[i] < 0 || joint[i] >= n) {
+      throw Error("differential_sensitivity: row " + std::to_string(i) + " names sample " +
+                  std::to_string(sample[i]) + ", joint " + std::to_string(joint[i]) +
+                  " outside the record (" + std::to_string(m) + " samples, " + std::to_string(n) +
+                  " joints)");
+    }
+  }
+  const auto p = static_cast<Eigen::Index>(columns.size());
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(3 * n * rows, p);
+  ProcessedRecord work = processed;
+  Eigen::MatrixXd* channel[3] = {&work.record.q, &work.record.dq, &work.record.ddq};
+  const Eigen::MatrixXd* original[3] = {&processed.record.q, &processed.record.dq,
+                                        &processed.record.ddq};
+  for (int c = 0; c < 3; ++c) {
+    // W is quadratic in q̇ and linear in q̈, so central differences are exact for any step; for q
+    // the step balances the O(h²) truncation against rounding (relative ~1e-10).
+    const double h = c == 0 ? 1e-5 : 1e-2;
+    for (int j = 0; j < n; ++j) {
+      channel[c]->col(j) = original[c]->col(j).array() + h;
+      const Eigen::MatrixXd plus = processed_regressor(model, layout, coupling, work);
+      channel[c]->col(j) = original[c]->col(j).array() - h;
+      const Eigen::MatrixXd minus = processed_regressor(model, layout, coupling, work);
+      channel[c]->col(j) = original[c]->col(j);
+      for (Eigen::Index i = 0; i < rows; ++i) {
+        const Eigen::Index r = static_cast<Eigen::Index>(sample[i]) * n + joint[i];
+        for (Eigen::Index k = 0; k < p; ++k) {
+          out(3 * n * i + c * n + j, k) = (plus(r, columns[k]) - minus(r, columns[k])) / (2.0 * h);
+        }
+      }
+    }
+  }
+  return out;
+}
+
+namespace {
+
+// The rows of one sample: first row, count, and the variances of their torques and of the
+// 3n variables (q, q̇, q̈ of every joint) the rows are built from.
+struct SampleRows {
+  Eigen::Index first = 0, count = 0;
+};
+
+// Whitened residual L⁻¹·b of one sample, S = L·Lᵀ = J·diag(var_x)·Jᵀ + diag(var_tau) (seed 2
+// eqs. 15–16). Returns false when S is not positive definite.
+class SampleCost {
+ public:
+  SampleCost(const EquationBlock& block, const Eigen::MatrixXd& sensitivity,
+             const Eigen::VectorXd& var_x, const Eigen::VectorXd& var_tau_row, SampleRows rows)
+      : block_(block),
+        sensitivity_(sensitivity),
+        var_x_(var_x),
+        var_tau_row_(var_tau_row),
+        rows_(rows) {}
+
+  template <typename Out>
+  bool whiten(const Eigen::Ref<const Eigen::VectorXd>& theta, Out&& residual,
+              Eigen::MatrixXd* whitened_rows = nullptr,
+              Eigen::VectorXd* whitened_y = nullptr) const {
+    const Eigen::Index r = rows_.count, n3 = var_x_.size();
+    const Eigen::VectorXd b =
+        block_.y.segment(rows_.first, r) - block_.W.middleRows(rows_.first, r) * theta;
+    Eigen::MatrixXd J(r, n3);
+    for (Eigen::Index a = 0; a < r; ++a) {
+      J.row(a) = (sensitivity_.middleRows(n3 * (rows_.first + a), n3) * theta).transpose();
+    }
+    Eigen::MatrixXd S = J * var_x_.asDiagonal() * J.transpose();
+    S.diagonal() += var_tau_row_.segment(rows_.first, r);
+    const Eigen::LLT<Eigen::MatrixXd> llt(S);
+    if (llt.info() != Eigen::Success) return false;
+    residual = llt.matrixL().solve(b);
+    if (whitened_rows) *whitened_rows = llt.matrixL().solve(block_.W.middleRows(rows_.first, r));
+    if (whitened_y) *whitened_y = llt.matrixL().solve(block_.y.segment(rows_.first, r));
+    return true;
+  }
+
+  bool operator()(double const* const* parameters, double* residuals) const {
+    const Eigen::Map<const Eigen::VectorXd> theta(parameters[0], block_.W.cols());
+    Eigen::Map<Eigen::VectorXd> out(residuals, rows_.count);
+    Eigen::VectorXd res(rows_.count);
+    if (!whiten(theta, res)) return false;
+    out = res;
+    return true;
+  }
+
+ private:
+  const EquationBlock& block_;
+  const Eigen::MatrixXd& sensitivity_;
+  const Eigen::VectorXd& var_x_;
+  const Eigen::VectorXd& var_tau_row_;
+  SampleRows rows_;
+};
+
+Eigen::VectorXd squared_or_zero(const Eigen::VectorXd& std, int n, const char* name) {
+  if (std.size() == 0) return Eigen::VectorXd::Zero(n);
+  if (std.size() != n || !std.allFinite() || (std.array() < 0.0).any()) {
+    throw Error(std::string("maximum likelihood: the ") + name + " noise needs " +
+                std::to_string(n) + " finite standard deviations >= 0, got " +
+                std::to_string(std.size()));
+  }
+  return std.array().square();
+}
+
+}  // namespace
+
+Estimate maximum_likelihood(const EquationBlock& block, const Eigen::MatrixXd& sensitivity,
+                            const MeasurementNoise& noise, const Eigen::VectorXd& start,
+                            const EstimationOptions& estimation_options,
+                            const MaximumLikelihoodOptions& options,
+                            MaximumLikelihoodSummary* summary) {
+  const Eigen::Index m = block.W.rows(), p = block.W.cols();
+  const auto n = static_cast<int>(noise.tau.size());
+  if (n < 1 || block.y.size() != m || block.sample.size() != m || block.group.size() != m ||
+      sensitivity.rows() != 3 * n * m || sensitivity.cols() != p || start.size() != p) {
+    throw Error("maximum likelihood: sizes do not match (W " + std::to_string(m) + "x" +
+                std::to_string(p) + ", sensitivity " + std::to_string(sensitivity.rows()) + "x" +
+                std::to_string(sensitivity.cols()) + ", start " + std::to_string(start.size()) +
+                ", " + std::to_string(n) + " joints)");
+  }
+  if (!start.allFinite()) throw Error("maximum likelihood: the start estimate is not finite");
+  if (!noise.tau.allFinite() || !(noise.tau.array() > 0.0).all()) {
+    throw Error(
+        "maximum likelihood needs a torque noise standard deviation > 0 for every joint; give "
+        "--noise-std tau=S or measure it with dynid average");
+  }
+  if (m <= p) {
+    throw Error("maximum likelihood: " + std::to_string(m) + " equations for " + std::to_string(p) +
+                " parameters; record a longer run");
+  }
+  Eigen::VectorXd var_x(3 * n);
+  var_x << squared_or_zero(noise.q, n, "position"), squared_or_zero(noise.dq, n, "velocity"),
+      squared_or_zero(noise.ddq, n, "acceleration");
+  Eigen::VectorXd var_tau_row(m);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    if (block.group[i] < 0 || block.group[i] >= n) {
+      throw Error("maximum likelihood: row " + std::to_string(i) + " has joint " +
+                  std::to_string(block.group[i]) + " outside the " + std::to_string(n) +
+                  " joints of the noise description");
+    }
+    var_tau_row[i] = noise.tau[block.group[i]] * noise.tau[block.group[i]];
+  }
+  std::vector<SampleRows> samples;
+  for (Eigen::Index i = 0; i < m; ++i) {
+    if (i > 0 && block.sample[i] < block.sample[i - 1]) {
+      throw Error("maximum likelihood: sample indices decrease at row " + std::to_string(i));
+    }
+    if (i == 0 || block.sample[i] != block.sample[i - 1]) samples.push_back({i, 0});
+    ++samples.back().count;
+  }
+
+  // Eq. 15 by Levenberg–Marquardt from the OLS start; central differences for the Jacobian (S
+  // depends on θ through B, eq. 16).
+  Eigen::VectorXd theta = start;
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  for (const SampleRows& s : samples) {
+    auto* cost = new ceres::DynamicNumericDiffCostFunction<SampleCost, ceres::CENTRAL>(
+        new SampleCost(block, sensitivity, var_x, var_tau_row, s));
+    cost->AddParameterBlock(static_cast<int>(p));
+    cost->SetNumResiduals(static_cast<int>(s.count));
+    problem.AddResidualBlock(cost, nullptr, theta.data());
+  }
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = options.max_iterations;
+  so.function_tolerance = options.function_tolerance;
+  so.parameter_tolerance = options.parameter_tolerance;
+  so.logging_type = ceres::SILENT;
+  so.minimizer_progress_to_stdout = false;
+  so.num_threads = 1;
+  ceres::Solver::Summary cs;
+  ceres::Solve(so, &problem, &cs);
+  if (!theta.allFinite() || cs.termination_type == ceres::FAILURE) {
+    throw Error("maximum likelihood did not converge (" + cs.message +
+                "); check the noise standard deviations and the start estimate");
+  }
+
+  // Statistics at the estimate on the whitened rows: the information F = W̃ᵀW̃.
+  Eigen::MatrixXd Wt(m, p);
+  Eigen::VectorXd yt(m), et(m);
+  for (const SampleRows& s : samples) {
+    SampleCost cost(block, sensitivity, var_x, var_tau_row, s);
+    Eigen::MatrixXd rows;
+    Eigen::VectorXd y, e(s.count);
+    if (!cost.whiten(theta, e, &rows, &y)) {
+      throw Error("maximum likelihood: the noise covariance of sample " +
+                  std::to_string(block.sample[s.first]) + " is singular at the estimate");
+    }
+    Wt.middleRows(s.first, s.count) = rows;
+    yt.segment(s.first, s.count) = y;
+    et.segment(s.first, s.count) = e;
+  }
+  Estimate est = ordinary_least_squares(Wt, yt, block.group, estimation_options);
+  const double dof = static_cast<double>(m - est.summary.rank);
+  const double variance_factor = et.squaredNorm() / dof;
+  if (est.residual_variance > 0.0) est.covariance *= variance_factor / est.residual_variance;
+  est.x = theta;
+  est.residual_variance = variance_factor;
+  fill_parameter_statistics(est, estimation_options);
+  const Eigen::VectorXd e = block.y - block.W * theta;
+  est.residual_rms = e.norm() / std::sqrt(static_cast<double>(m));
+  est.relative_error = e.norm() / std::max(block.y.norm(), 1e-300);
+  for (Eigen::Index g = 0; g < est.group_rms.size(); ++g) {
+    double e2 = 0.0, y2 = 0.0, count = 0.0;
+    for (Eigen::Index i = 0; i < m; ++i) {
+      if (block.group[i] != g) continue;
+      e2 += e[i] * e[i];
+      y2 += block.y[i] * block.y[i];
+      count += 1.0;
+    }
+    est.group_rms[g] = count > 0 ? std::sqrt(e2 / count) : NAN;
+    est.group_relative_error[g] = y2 > 0 ? std::sqrt(e2 / y2) : NAN;
+  }
+  est.summary.estimator = EstimatorKind::kMaximumLikelihood;
+  est.summary.passes = static_cast<int>(cs.iterations.size());
+  if (options.hac) apply_hac_covariance(est, Wt, et, block.sample, estimation_options);
+  if (summary != nullptr) {
+    summary->iterations = static_cast<int>(cs.iterations.size());
+    summary->initial_cost = cs.initial_cost;
+    summary->final_cost = cs.final_cost;
+    summary->converged = cs.termination_type == ceres::CONVERGENCE;
+    summary->termination = cs.message;
+    summary->variance_factor = variance_factor;
+  }
+  return est;
+}
+
+}  // namespace dynid
