@@ -10,6 +10,7 @@
 #include "dynid/dynamics/workspace.hpp"
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/statistics.hpp"
+#include "estimation/experiment_columns.hpp"
 
 namespace dynid {
 
@@ -80,9 +81,7 @@ FrictionExperimentResult fit_friction_experiment(const Model& model,
       if (std::abs(v) < threshold) continue;
       rnea(rigid, ws, p.record.q.row(k).transpose(), p.record.dq.row(k).transpose(),
            p.record.ddq.row(k).transpose(), tau);
-      const double pos = filtered ? p.moving_positive(k, joint) : static_cast<double>(v > 0.0);
-      const double neg = filtered ? p.moving_negative(k, joint) : static_cast<double>(v < 0.0);
-      W.row(i) << (v > 0.0 ? v : 0.0), (v < 0.0 ? v : 0.0), pos, -neg;
+      W.row(i) = detail::friction_columns(p, k, joint).transpose();
       y[i] = p.record.tau(k, joint) - tau[joint];
       positive += v > 0.0;
       negative += v < 0.0;

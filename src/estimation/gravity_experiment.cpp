@@ -7,12 +7,11 @@
 #include "dynid/common/error.hpp"
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/statistics.hpp"
+#include "estimation/experiment_columns.hpp"
 
 namespace dynid {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 double median(std::vector<double> v) {
   const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
@@ -63,6 +62,34 @@ Slope find_slope(const ProcessedRecord& p, int r, int joint, int direction,
 }
 
 }  // namespace
+
+namespace detail {
+
+Sinusoid sinusoid_from_linear(double a, double b, const Eigen::Matrix2d& C) {
+  constexpr double kPi = 3.14159265358979323846;
+  Sinusoid s;
+  const double r2 = a * a + b * b;
+  s.q_off = std::atan2(b, a);
+  s.k = std::sqrt(r2);
+  if (s.q_off > kPi / 2) {
+    s.q_off -= kPi;
+    s.k = -s.k;
+  } else if (s.q_off <= -kPi / 2) {
+    s.q_off += kPi;
+    s.k = -s.k;
+  }
+  if (r2 > 0.0) {
+    const Eigen::Vector2d dk(a / s.k, b / s.k), dq(-b / r2, a / r2);
+    s.k_std = std::sqrt(dk.dot(C * dk));
+    s.q_off_std = std::sqrt(dq.dot(C * dq));
+  } else {
+    s.k_std = std::sqrt(C.trace());
+    s.q_off_std = INFINITY;
+  }
+  return s;
+}
+
+}  // namespace detail
 
 GravityExperimentResult fit_gravity_experiment(const std::vector<ProcessedRecord>& runs, int joint,
                                                const GravityExperimentOptions& options) {
@@ -150,24 +177,12 @@ GravityExperimentResult fit_gravity_experiment(const std::vector<ProcessedRecord
   out.residual_rms = e.norm() / std::sqrt(static_cast<double>(rows));
   out.sample_tau = y;
   out.sample_fitted = W * out.estimate.x;
-  // τ = a·sin q + b·cos q = k·sin(q + q_off) with a = k cos q_off, b = k sin q_off.
-  const double a = out.estimate.x[0], b = out.estimate.x[1];
-  const double r2 = a * a + b * b;
-  double q_off = std::atan2(b, a), k = std::sqrt(r2);
-  if (q_off > kPi / 2) {
-    q_off -= kPi;
-    k = -k;
-  } else if (q_off <= -kPi / 2) {
-    q_off += kPi;
-    k = -k;
-  }
-  out.k = k;
-  out.q_off = q_off;
-  // Delta method: ∂k/∂(a, b) = (a, b)/k, ∂q_off/∂(a, b) = (−b, a)/r².
-  const Eigen::Matrix2d C = out.estimate.covariance.topLeftCorner<2, 2>();
-  const Eigen::Vector2d dk(a / k, b / k), dq(-b / r2, a / r2);
-  out.k_std = std::sqrt(dk.dot(C * dk));
-  out.q_off_std = std::sqrt(dq.dot(C * dq));
+  const detail::Sinusoid g = detail::sinusoid_from_linear(
+      out.estimate.x[0], out.estimate.x[1], out.estimate.covariance.topLeftCorner<2, 2>());
+  out.k = g.k;
+  out.q_off = g.q_off;
+  out.k_std = g.k_std;
+  out.q_off_std = g.q_off_std;
   out.k_ci_half_width = h.critical_value * out.k_std;
   out.q_off_ci_half_width = h.critical_value * out.q_off_std;
   for (Eigen::Index s = 0; s < S; ++s) {
@@ -181,7 +196,7 @@ GravityExperimentResult fit_gravity_experiment(const std::vector<ProcessedRecord
   out.choices.emplace_back("covariance", "Newey-West (HAC) over samples, Bartlett window of " +
                                              std::to_string(h.bandwidth) +
                                              " samples; k and q_off by the delta method");
-  if (std::abs(k) < h.critical_value * out.k_std) {
+  if (std::abs(out.k) < h.critical_value * out.k_std) {
     out.warnings.push_back("the gravity amplitude of joint " + std::to_string(joint + 1) +
                            " is not distinguishable from zero at this level: its axis may be "
                            "vertical, and q_off then means nothing");
