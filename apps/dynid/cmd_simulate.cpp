@@ -8,27 +8,41 @@
 #include "dynid/io/csv_writer.hpp"
 #include "dynid/io/joint_record_file.hpp"
 #include "dynid/model/robots.hpp"
+#include "dynid/sim/pid_gains.hpp"
 #include "dynid/sim/simulate_reference.hpp"
 
 namespace dynid::cli {
 namespace {
 
 struct SimulateCliOptions {
-  std::string robot, trajectory, out, engine = "mujoco";
+  std::string robot, trajectory, out, engine = "mujoco", controller = "pid-feedforward", gains;
   int periods = 25, delay = 0;
   unsigned seed = 1;
   double position_noise = 0.0, torque_noise = 0.0, counts_per_rev = 0.0;
   bool truth = false;
 };
 
+// The gains file written next to the run: run.csv -> run.gains.json (docs/cli.md).
+std::string gains_file_for(const std::string& out) {
+  const std::string suffix = ".csv";
+  const bool csv = out.size() > suffix.size() &&
+                   out.compare(out.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return (csv ? out.substr(0, out.size() - suffix.size()) : out) + ".gains.json";
+}
+
 void run(const SimulateCliOptions& o) {
   if (o.engine != "mujoco" && o.engine != "native") {
     throw UsageError("--engine must be mujoco or native, not '" + o.engine + "'");
+  }
+  if (o.controller != "pid" && o.controller != "pid-feedforward") {
+    throw UsageError("--controller must be pid or pid-feedforward, not '" + o.controller + "'");
   }
   if (o.periods < 1) throw UsageError("--periods must be >= 1");
   const Model model = load_robot(o.robot);
   const JointRecord ref = read_reference(o.trajectory, model);
   SimulateOptions s;
+  s.feed_forward = o.controller == "pid" ? FeedForward::kNone : FeedForward::kComputedTorque;
+  if (!o.gains.empty()) s.gains = read_pid_gains(o.gains, model);
   s.plant.engine = o.engine == "mujoco" ? PlantEngine::kMujoco : PlantEngine::kNative;
   s.sensors.position_noise_std = o.position_noise;
   s.sensors.torque_noise_std = o.torque_noise;
@@ -37,7 +51,8 @@ void run(const SimulateCliOptions& o) {
   s.sensors.seed = o.seed;
   s.loop.periods = o.periods;
   s.loop.record_truth = o.truth;
-  const ClosedLoopResult r = simulate_reference(model, ref.t, ref.q, ref.dq, ref.ddq, s);
+  PidOptions pid;
+  const ClosedLoopResult r = simulate_reference(model, ref.t, ref.q, ref.dq, ref.ddq, s, &pid);
   const Eigen::Index n = model.dof();
   std::vector<std::string> cols = {"t"};
   std::vector<const char*> prefixes = {"qr", "q", "tau"};
@@ -50,9 +65,12 @@ void run(const SimulateCliOptions& o) {
   } else {
     data << r.t, r.qr, r.q, r.tau;
   }
+  const std::string gains_path = gains_file_for(o.out);
   write_csv(o.out, cols, data);
+  write_pid_gains(gains_path, model, pid, o.delay);
   std::cout << "simulated " << r.t.size() << " samples (" << o.periods << " periods) on the "
-            << o.engine << " plant; wrote " << o.out << '\n';
+            << o.engine << " plant with " << o.controller << "; wrote " << o.out << " and "
+            << gains_path << '\n';
 }
 
 }  // namespace
@@ -61,7 +79,8 @@ void add_simulate_command(CLI::App& app) {
   auto o = std::make_shared<SimulateCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "simulate",
-      "Run a reference trajectory in closed loop (PID + feed-forward) on a simulated robot");
+      "Run a reference trajectory in closed loop (PID, with or without feed-forward) on a "
+      "simulated robot");
   cmd->add_option("--robot,-r", o->robot, "Built-in robot name or .urdf/.yaml model")->required();
   cmd->add_option(
          "--trajectory,-t", o->trajectory,
@@ -70,6 +89,14 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--out,-o", o->out, "Run CSV: t, qr*, q*, tau* (and dq*, ddq* with --truth)")
       ->required();
   cmd->add_option("--engine", o->engine, "mujoco or native")->capture_default_str();
+  cmd->add_option("--controller", o->controller,
+                  "pid (plain joint PID, the closed loop of B. Bona, A. Curatella, Closed-loop "
+                  "rigid model identification of an industrial robot, 2005) or pid-feedforward "
+                  "(PID plus computed torque from the true model)")
+      ->capture_default_str();
+  cmd->add_option("--gains", o->gains,
+                  "YAML file with kp, ki, kd lists (one value per joint); default: a bandwidth "
+                  "rule that accounts for --delay. The gains used are written to <out>.gains.json");
   cmd->add_option("--periods", o->periods, "Periods of the reference to run")
       ->capture_default_str();
   cmd->add_option("--seed", o->seed, "Noise seed")->capture_default_str();

@@ -33,4 +33,7 @@ void add_excite_command(CLI::App& app);
 /// `dynid simulate`: closed-loop run of a reference on a simulated robot (cmd_simulate.cpp).
 void add_simulate_command(CLI::App& app);
 
+/// `dynid average`: mean period and noise statistics of a periodic run (cmd_average.cpp).
+void add_average_command(CLI::App& app);
+
 }  // namespace dynid::cli

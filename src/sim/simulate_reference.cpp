@@ -5,30 +5,77 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
+
 #include "dynid/dynamics/mass_matrix.hpp"
 #include "dynid/signal/sampling_check.hpp"
 
 namespace dynid {
 
+namespace {
+
+// ω·(loop lag) of the delay-free rule at its tightest (rate ≤ 320 Hz: ω = 2π·rate/40, lag = Ts +
+// 2·Ts): 2π·3/40. Keeping ω·lag at or below it keeps the phase lost to the lag at ~27° whatever
+// the measurement delay, so the delay-free loops are unchanged and delayed ones stay stable.
+constexpr double kLoopLagBudget = 2 * M_PI * 3.0 / 40.0;
+
+}  // namespace
+
 PidOptions default_pid_options(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q0,
-                               double rate_hz) {
+                               double rate_hz, int delay_samples, FeedForward feed_forward) {
+  if (!(rate_hz > 0.0) || !std::isfinite(rate_hz))
+    throw Error("controller rate must be finite and > 0 Hz, got " + short_number(rate_hz));
+  if (delay_samples < 0)
+    throw Error("measurement delay must be >= 0 samples, got " + std::to_string(delay_samples));
   Workspace ws(model);
   Eigen::MatrixXd M(model.dof(), model.dof());
   mass_matrix(model, ws, q0, M);
-  // A discrete loop needs its bandwidth well below the sample rate (rate/40) and a derivative
-  // filter of at least two samples.
-  const double w = 2 * M_PI * std::min(8.0, rate_hz / 40.0);
   PidOptions o;
-  o.kp = M.diagonal() * w * w;
-  o.kd = M.diagonal() * 2 * 0.9 * w;
-  o.ki = o.kp * 0.5;
   o.sample_time = 1.0 / rate_hz;
   o.derivative_filter_time = std::max(o.derivative_filter_time, 2.0 / rate_hz);
-  o.feed_forward = FeedForward::kComputedTorque;
+  // A discrete loop needs its bandwidth well below the sample rate (rate/40) and below the
+  // inverse of its lag; a derivative filter of at least two samples.
+  const double lag = (delay_samples + 1) * o.sample_time + o.derivative_filter_time;
+  double w = 2 * M_PI * std::min(8.0, rate_hz / 40.0);
+  if (delay_samples > 0) w = std::min(w, kLoopLagBudget / lag);  // inactive without delay
+  // Gains per joint ∝ M_jj place the modes of M·ë = −K·e at ω·sqrt(μ), μ the eigenvalues of
+  // M⁻¹·diag(M) ≥ 1 on average; coupling (planar2's elbow, a 7-joint arm's light wrist) makes
+  // μ_max ≫ 1, a fast mode a delayed or feedback-only loop cannot hold. Dividing by μ_max keeps
+  // every mode at or below ω. The delay-free feed-forward loop keeps its historical gains, which
+  // recorded runs and validate_run_by_simulation() rely on.
+  double mu_max = 1.0;
+  if (delay_samples > 0 || feed_forward == FeedForward::kNone) {
+    const Eigen::VectorXd d_sqrt = M.diagonal().cwiseSqrt();
+    const Eigen::MatrixXd scaled =
+        d_sqrt.asDiagonal() * M.ldlt().solve(Eigen::MatrixXd(d_sqrt.asDiagonal()));
+    mu_max = std::max(1.0, Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(
+                               0.5 * (scaled + scaled.transpose()), Eigen::EigenvaluesOnly)
+                               .eigenvalues()
+                               .maxCoeff());
+  }
+  o.kp = M.diagonal() * w * w / mu_max;  // this order: bit-identical historical gains at μ = 1
+  o.kd = M.diagonal() * 2 * 0.9 * w / mu_max;
+  o.ki = o.kp * 0.5;
+  o.feed_forward = feed_forward;
   o.effort_limit = Eigen::VectorXd::Constant(model.dof(), 1e6);
   return o;
+}
+
+PidOptions simulation_pid_options(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q0,
+                                  double rate_hz, const SimulateOptions& options) {
+  PidOptions o =
+      default_pid_options(model, q0, rate_hz, options.sensors.position_delay, options.feed_forward);
+  if (options.gains.kp.size() > 0) {
+    o.kp = options.gains.kp;
+    o.ki = options.gains.ki;
+    o.kd = options.gains.kd;
+  }
+  PidController check(model, o);  // the controller's own checks: sizes, finite, >= 0
+  return check.options();
 }
 
 namespace {
@@ -119,13 +166,15 @@ ClosedLoopResult simulate_reference(const Model& model, const Eigen::Ref<const E
                                     const Eigen::Ref<const Eigen::MatrixXd>& q,
                                     const Eigen::Ref<const Eigen::MatrixXd>& dq,
                                     const Eigen::Ref<const Eigen::MatrixXd>& ddq,
-                                    SimulateOptions options) {
+                                    SimulateOptions options, PidOptions* controller_used) {
   const SamplingInfo info = require_uniform_sampling(t, 1e-6, "closed-loop simulation");
   const Reference ref = periodic_reference(t, q, dq, ddq);
   check_reference_rows(model, ref.q);
   options.plant.dt = info.mean_period;
   auto plant = make_plant(model, options.plant);
-  PidController pid(model, default_pid_options(model, q.row(0).transpose(), info.rate_hz()));
+  PidController pid(model,
+                    simulation_pid_options(model, q.row(0).transpose(), info.rate_hz(), options));
+  if (controller_used != nullptr) *controller_used = pid.options();
   Sensors sensors(model, options.sensors);
   ClosedLoopResult result = run_closed_loop(ref, pid, *plant, sensors, options.loop);
   check_simulated_run(model, result, ref, options.sensors);

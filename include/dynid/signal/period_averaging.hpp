@@ -1,5 +1,8 @@
 #pragma once
 
+#include <limits>
+#include <vector>
+
 #include <Eigen/Core>
 
 namespace dynid {
@@ -44,5 +47,71 @@ struct PeriodDetectionOptions {
 /// into m samples, or when no correlation peak is found in the range.
 int detect_period(const Eigen::Ref<const Eigen::VectorXd>& reference,
                   const PeriodDetectionOptions& options = {});
+
+/// Options of average_periods_in_time().
+struct TimedPeriodAverageOptions {
+  double start = std::numeric_limits<double>::quiet_NaN();  ///< time of the first period's start
+                                                            ///< [s]; NaN = the first sample's t
+  int skip_periods = 0;  ///< complete periods dropped after start (start-up transient)
+};
+
+/// Noise statistics of one channel from its residuals about the mean period.
+struct ChannelNoise {
+  double std = 0.0;          ///< noise standard deviation (unbiased variance, see below)
+  double skewness = 0.0;     ///< third standardised moment (0 for Gaussian); NaN if std = 0
+  double kurtosis = 0.0;     ///< fourth standardised moment (3 for Gaussian); NaN if std = 0
+  double normality_p = 0.0;  ///< D'Agostino–Pearson K² test p-value; NaN if std = 0
+};
+
+/// The mean period of a run with a period given in seconds, and per channel noise statistics.
+struct TimedPeriodAverage {
+  Eigen::VectorXd phase;  ///< P phase times k·T/P [s] from the period start, P = round(T/Ts)
+  Eigen::MatrixXd
+      mean;  ///< P × c mean period: average over the periods of x at start + i·T + phase
+  std::vector<ChannelNoise> channels;  ///< per column of x
+  int periods = 0;                     ///< complete periods averaged (after skip_periods)
+  double samples_per_period = 0.0;     ///< T/Ts, not necessarily an integer
+  bool interpolated = false;           ///< T/Ts or the start not on the sample grid
+  double start = 0.0;                  ///< first period's start [s]
+  double sample_time = 0.0;            ///< Ts [s], mean step of t
+  long samples_before = 0;             ///< samples before the first averaged period (not used)
+  long samples_after = 0;              ///< samples after the last complete period (not used)
+  double partial_period = 0.0;         ///< fraction of a period left after the last complete one
+  long residual_samples = 0;           ///< samples whose residuals give the statistics
+};
+
+/// Averages the complete periods of x (m × c, rows at the uniformly spaced times t) for a period
+/// of `period` seconds that need not be a whole number of samples, and a first period starting at
+/// any time (seed 2 §3.4 and Fig. 5: 25 repetitions averaged, noise PDF from them). Values between
+/// samples come from 4-point Lagrange (cubic) interpolation in the sample index, so the periods'
+/// start times may drift across the sample grid; on the grid the weights are exactly 0/1.
+/// Noise: each sample s of period i gets the residual e_s = x_s − mean_{j≠i} x(start + j·T + φ_s)
+/// (leave-one-out, so e_s holds that sample's own noise); with white noise of variance σ²,
+/// E[e_s²] = σ²·c_s, c_s = 1 + Σ_j Σ w²/(K − 1)² from the interpolation weights w, and
+/// σ̂² = mean(e_s²/c_s) is unbiased. skewness = m3(e)/σ̂³, kurtosis = 3 + (m4(e) − 3·m2(e)²)/σ̂⁴
+/// (the averaged term is nearly Gaussian and independent of the sample's noise, so e's third and
+/// fourth cumulants are the noise's). normality_p: dagostino_pearson() on the residuals.
+/// Throws dynid::Error for t not uniform (rel. 1e-6) or not matching x, non-finite x, period not
+/// finite or ≤ 2 samples, start outside the run, skip_periods < 0, or fewer than 2 complete
+/// periods (the message gives the run length and the period).
+TimedPeriodAverage average_periods_in_time(const Eigen::Ref<const Eigen::VectorXd>& t,
+                                           const Eigen::Ref<const Eigen::MatrixXd>& x,
+                                           double period,
+                                           const TimedPeriodAverageOptions& options = {});
+
+/// Result of a normality test.
+struct NormalityTest {
+  double skewness = 0.0;  ///< sample skewness g1 = m3/m2^{3/2}
+  double kurtosis = 0.0;  ///< sample kurtosis b2 = m4/m2² (3 for Gaussian)
+  double k2 = 0.0;        ///< Z1² + Z2²
+  double p = 0.0;         ///< P(χ²₂ > K²) = exp(−K²/2)
+};
+
+/// D'Agostino–Pearson omnibus K² test of normality (R. B. D'Agostino, A. Belanger, R. B.
+/// D'Agostino Jr., "A suggestion for using powerful and informative tests of normality", The
+/// American Statistician 44(4), 1990): Z1 from the skewness (D'Agostino 1970), Z2 from the
+/// kurtosis (Anscombe–Glynn 1983), K² = Z1² + Z2² ~ χ²₂ under normality. Needs n ≥ 20 samples.
+/// Throws dynid::Error for n < 20, non-finite values, or zero variance.
+NormalityTest dagostino_pearson(const Eigen::Ref<const Eigen::VectorXd>& x);
 
 }  // namespace dynid
