@@ -1,0 +1,208 @@
+#include "dynid/estimation/integral_equations.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "dynid/common/error.hpp"
+#include "dynid/dynamics/workspace.hpp"
+#include "dynid/model/transmission.hpp"
+#include "dynid/regressor/energy_regressor.hpp"
+
+namespace dynid {
+
+namespace {
+
+std::string fmt(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+
+void check_processed(const Model& model, const JointRecord& r) {
+  const int n = model.dof();
+  const Eigen::Index m = r.t.size();
+  auto check = [&](const Eigen::MatrixXd& x, const char* what) {
+    if (x.rows() != m || x.cols() != n) {
+      throw Error(std::string("integral model: ") + what + " has " + std::to_string(x.rows()) +
+                  "×" + std::to_string(x.cols()) + " values; expected " + std::to_string(m) + "×" +
+                  std::to_string(n) + " (samples × joints of model '" + model.name +
+                  "'); preprocess the run first");
+    }
+    if (!x.allFinite())
+      throw Error(std::string("integral model: ") + what + " contains NaN or Inf");
+  };
+  check(r.q, "q");
+  check(r.dq, "dq");
+  check(r.tau, "tau");
+  for (Eigen::Index k = 0; k + 1 < m; ++k) {
+    if (!(r.t[k + 1] > r.t[k])) {
+      throw Error("integral model: time stamps must increase strictly (sample " +
+                  std::to_string(k + 1) + ")");
+    }
+  }
+}
+
+}  // namespace
+
+EquationBlock integral_equations(const Model& model, const ParameterLayout& layout, bool coupling,
+                                 const ProcessedRecord& processed, const IntegralOptions& options) {
+  const JointRecord& r = processed.record;
+  check_processed(model, r);
+  const int n = model.dof();
+  const Eigen::Index m = r.t.size();
+  if (m < 2) throw Error("integral model: the run has fewer than two samples");
+  const double duration = r.t[m - 1] - r.t[0];
+  const double step = duration / static_cast<double>(m - 1);
+  if (!(options.interval >= 0.0) || !std::isfinite(options.interval)) {
+    throw UsageError("integral interval " + fmt(options.interval) +
+                     " s is not a length; give a positive number of seconds (0 = automatic)");
+  }
+  const Eigen::Index steps = options.interval == 0.0
+                                 ? kAutoIntervalSteps
+                                 : static_cast<Eigen::Index>(std::llround(options.interval / step));
+  if (steps < 1) {
+    throw UsageError("integral interval " + fmt(options.interval) +
+                     " s is shorter than two samples of the processed run (one step is " +
+                     fmt(step) + " s); give at least " + fmt(step) + " s");
+  }
+  if (steps > m - 1) {
+    throw UsageError("integral interval " + fmt(options.interval) + " s is longer than the run (" +
+                     fmt(duration) + " s after processing); give at most " + fmt(duration) + " s");
+  }
+  // A run in which no joint moves beyond its position noise carries no energy information.
+  bool moves = false;
+  for (int j = 0; j < n; ++j) {
+    const double noise =
+        processed.position_noise_std.size() == n ? processed.position_noise_std[j] : 0.0;
+    const double range = r.q.col(j).maxCoeff() - r.q.col(j).minCoeff();
+    moves |= range > std::max(10.0 * noise, 1e-9);
+  }
+  if (!moves) {
+    throw Error(
+        "integral model: no joint moves in the run (every position range is within its "
+        "noise); record a run in which the joints move");
+  }
+
+  const int p = layout.columns(n);
+  const int jc = layout.joint_columns();
+  const std::vector<int> motors = coupling ? coupled_motors(model) : std::vector<int>{};
+  const int cols = p + 3 * static_cast<int>(motors.size());
+  std::vector<Eigen::RowVectorXd> n_k;
+  for (int k : motors) {
+    const Eigen::RowVectorXd row = model.transmission.N.row(k);
+    n_k.push_back(row / row.cwiseAbs().maxCoeff());
+  }
+  const Eigen::Index intervals = (m - 1) / steps;
+
+  EquationBlock b;
+  b.W.setZero(intervals, cols);
+  b.y.setZero(intervals);
+  b.group.setZero(intervals);
+  b.sample.resize(intervals);
+  b.t.resize(intervals);
+  b.columns = stacked_regressor_names(model, layout, coupling);
+  b.group_names = {"energy"};
+
+  // Energy row at a boundary sample: h(q, q̇) and, per coupled motor, ½(u² − Σ n_kj² q̇_j²) (the
+  // energy of the motor's off-diagonal inertia terms, whose torque is coupling_regressor's Iam).
+  Workspace ws(model);
+  Eigen::VectorXd h_prev(cols), h_next(cols);
+  auto energy_row = [&](Eigen::Index k, Eigen::VectorXd& h) {
+    energy_regressor(model, ws, layout, r.q.row(k).transpose(), r.dq.row(k).transpose(), h.head(p));
+    for (size_t c = 0; c < motors.size(); ++c) {
+      const double u = n_k[c].dot(r.dq.row(k));
+      const double diag = (n_k[c].array().square() * r.dq.row(k).array().square()).sum();
+      h[p + 3 * static_cast<Eigen::Index>(c)] = 0.5 * (u * u - diag);
+      h[p + 3 * static_cast<Eigen::Index>(c) + 1] = 0.0;
+      h[p + 3 * static_cast<Eigen::Index>(c) + 2] = 0.0;
+    }
+  };
+  Eigen::VectorXd power;
+  if (options.rule != IntegrationRule::kZeroOrderHold) {
+    power = (r.tau.array() * r.dq.array()).rowwise().sum();
+  }
+  // Column of the first friction term of joint j (after its armature column, joint_columns order).
+  const int friction_first = layout.armature ? 1 : 0;
+  Eigen::VectorXd square(n);  // per-joint ∫q̇_j² of one step, reused by the coupled motors
+  energy_row(0, h_prev);
+  for (Eigen::Index i = 0; i < intervals; ++i) {
+    const Eigen::Index a = i * steps, e = a + steps;
+    energy_row(e, h_next);
+    auto w = b.W.row(i);
+    w = (h_next - h_prev).transpose();
+    if (options.rule == IntegrationRule::kZeroOrderHold) {
+      double y = 0.0;
+      for (Eigen::Index k = a; k < e; ++k) y += r.tau.row(k).dot(r.q.row(k + 1) - r.q.row(k));
+      b.y[i] = y;
+    } else {
+      b.y[i] = integrate_samples(r.t, power, a, e, options.rule);
+    }
+    for (Eigen::Index k = a; k < e; ++k) {
+      const double hk = r.t[k + 1] - r.t[k];
+      for (int j = 0; j < n; ++j) {
+        const StepVelocityIntegrals s =
+            step_velocity_integrals(hk, r.q(k + 1, j) - r.q(k, j), r.dq(k, j), r.dq(k + 1, j));
+        square[j] = s.positive_square + s.negative_square;
+        Eigen::Index c = kLinkParams * n + jc * j + friction_first;
+        if (layout.asymmetric) {
+          if (layout.viscous) {
+            w[c++] += s.positive_square;
+            w[c++] += s.negative_square;
+          }
+          if (layout.coulomb) {
+            w[c++] += s.positive;
+            w[c++] -= s.negative;
+          }
+        } else {
+          if (layout.viscous) w[c++] += square[j];
+          if (layout.coulomb) w[c++] += s.positive - s.negative;
+        }
+        if (layout.offset) w[c++] += s.positive + s.negative;
+      }
+      for (size_t c = 0; c < motors.size(); ++c) {
+        const Eigen::RowVectorXd& nk = n_k[c];
+        const StepVelocityIntegrals u = step_velocity_integrals(
+            hk, nk.dot(r.q.row(k + 1) - r.q.row(k)), nk.dot(r.dq.row(k)), nk.dot(r.dq.row(k + 1)));
+        const Eigen::Index col = p + 3 * static_cast<Eigen::Index>(c);
+        w[col + 1] += u.positive_square + u.negative_square -
+                      (nk.array().square().transpose() * square.array()).sum();
+        w[col + 2] += u.positive - u.negative;
+      }
+    }
+    b.sample[i] = static_cast<int>(i);
+    b.t[i] = r.t[e];
+    std::swap(h_prev, h_next);
+  }
+  if (options.weight_rows && !options.long_integrals) {
+    Eigen::VectorXd scale(intervals);
+    for (Eigen::Index i = 0; i < intervals; ++i) {
+      double s2 = 0.0;
+      for (Eigen::Index k = i * steps; k < (i + 1) * steps; ++k) {
+        const double hk = r.t[k + 1] - r.t[k];
+        s2 += hk * hk * r.dq.row(k).squaredNorm();
+      }
+      scale[i] = std::sqrt(s2);
+    }
+    const double rms = std::sqrt(scale.squaredNorm() / static_cast<double>(intervals));
+    // An interval without motion carries no torque-noise work and no information: leave it.
+    for (Eigen::Index i = 0; i < intervals; ++i) {
+      const double s = scale[i] / rms;
+      if (s > 1e-6) {
+        b.W.row(i) /= s;
+        b.y[i] /= s;
+      }
+    }
+  }
+  if (options.long_integrals) {
+    // Seed 1 §IV: [t0, t_b] for every interval end t_b; energy differences telescope and the
+    // friction and power integrals add, so a long row is the running sum of the short ones.
+    for (Eigen::Index i = 1; i < intervals; ++i) {
+      b.W.row(i) += b.W.row(i - 1);
+      b.y[i] += b.y[i - 1];
+    }
+  }
+  return b;
+}
+
+}  // namespace dynid
