@@ -205,4 +205,11 @@ EquationBlock integral_equations(const Model& model, const ParameterLayout& layo
   return b;
 }
 
+SignalOptions integral_signal_options() {
+  SignalOptions o;
+  o.cutoff_hz = 10.0;
+  o.decimate = 1;
+  return o;
+}
+
 }  // namespace dynid

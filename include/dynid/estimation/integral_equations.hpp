@@ -13,9 +13,10 @@ namespace dynid {
 struct IntegralOptions {
   /// Interval length [s], rounded to a whole number of steps of the processed record; the run is
   /// cut into consecutive, non-overlapping intervals from its first sample (samples after the
-  /// last whole interval are not used). 0 = automatic: kAutoIntervalSteps steps. Seed 1 used
-  /// 5 ms at 0.5 ms sampling (10 steps).
-  double interval = 0.0;
+  /// last whole interval are not used). 0 = kAutoIntervalSteps steps. Seed 1 used 5 ms at 0.5 ms
+  /// sampling; 10 ms was among the best short intervals measured (docs/methods/estimation.md,
+  /// "Integral model"), and longer ones lost accuracy on the TX40 run.
+  double interval = 0.01;
   /// Long integrals (seed 1 §IV): interval k runs from the first sample to the end of short
   /// interval k, i.e. the rows are running sums of the short ones.
   bool long_integrals = false;
@@ -53,5 +54,12 @@ inline constexpr int kAutoIntervalSteps = 2;
 EquationBlock integral_equations(const Model& model, const ParameterLayout& layout, bool coupling,
                                  const ProcessedRecord& processed,
                                  const IntegralOptions& options = {});
+
+/// Signal processing for the integral model (preprocess()): the differential defaults except a
+/// fixed 10 Hz cut-off (the automatic rule, tuned for q̈, chose 1.1 Hz on a simulated run and the
+/// filter's distortion of τᵀq̇ then dominated: 56 % torque error against 24 % at 10 Hz) and no
+/// decimation (the power is integrated at the full rate). Measurements in
+/// docs/methods/estimation.md, "Integral model".
+SignalOptions integral_signal_options();
 
 }  // namespace dynid

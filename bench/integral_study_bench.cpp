@@ -1,0 +1,171 @@
+// Item 5 of issue 11: how good the integral (energy) model can be on noisy closed-loop data.
+// Simulates two closed-loop runs of the puma560 (native RK4 plant with tanh Coulomb friction,
+// PID + computed-torque feed-forward, 1 kHz, encoder noise 1e-4 rad, torque noise 0.05 N·m),
+// identifies on run A with the differential model (identify() defaults) and with the integral
+// model over a grid of signal processing and interval choices, and prints each estimate's
+// torque-prediction error on run B (validate_torques with the differential defaults).
+// Not a benchmark: a study whose table is in docs/methods/estimation.md ("Integral model").
+// Run: ./build/bench/integral_study_bench [position-noise-scale [torque-noise-scale]] (1 1 = the
+// noise above; 0 0 = noise-free).
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <vector>
+
+#include "dynid/estimation/identification.hpp"
+#include "dynid/estimation/integral_equations.hpp"
+#include "dynid/estimation/least_squares.hpp"
+#include "dynid/model/robots.hpp"
+#include "dynid/sim/closed_loop.hpp"
+#include "dynid/sim/pid_controller.hpp"
+#include "dynid/sim/plant.hpp"
+#include "dynid/sim/sensors.hpp"
+
+namespace {
+
+using namespace dynid;
+
+Reference multisine(int n, double duration, double ts, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const Eigen::Index m = std::llround(duration / ts);
+  Reference r;
+  r.t = Eigen::VectorXd::LinSpaced(m, 0.0, (m - 1) * ts);
+  r.q.setZero(m, n);
+  r.dq.setZero(m, n);
+  r.ddq.setZero(m, n);
+  for (int j = 0; j < n; ++j) {
+    for (int k = 1; k <= 5; ++k) {
+      const double w = 2 * M_PI * k / duration, a = 1.0 * u(rng) / k, phi = M_PI * u(rng);
+      for (Eigen::Index i = 0; i < m; ++i) {
+        const double s = std::sin(w * r.t[i] + phi), c = std::cos(w * r.t[i] + phi);
+        r.q(i, j) += a * s;
+        r.dq(i, j) += a * w * c;
+        r.ddq(i, j) -= a * w * w * s;
+      }
+    }
+  }
+  return r;
+}
+
+double g_noise = 1.0, g_torque_noise = 1.0;
+// The grid (cut-off < 0: no filter; interval 0: automatic).
+const std::vector<double> kCutoffs = {0.0, 2.0, 5.0, 10.0, 20.0, 40.0, 80.0, -1.0};
+const std::vector<double> kIntervalsMs = {0.0, 5.0, 10.0, 50.0, 100.0, 200.0, 500.0, 1000.0};
+
+JointRecord run(const Model& model, unsigned seed, double ts) {
+  const int n = model.dof();
+  PidOptions po;
+  po.kp = Eigen::VectorXd::Constant(n, 400.0);
+  po.kd = Eigen::VectorXd::Constant(n, 40.0);
+  po.sample_time = ts;
+  po.feed_forward = FeedForward::kComputedTorque;
+  po.effort_limit = Eigen::VectorXd::Constant(n, 1e6);
+  PidController pid(model, po);
+  PlantOptions p;
+  p.dt = ts;
+  auto plant = make_plant(model, p);
+  SensorOptions so;
+  so.position_noise_std = 1e-4 * g_noise;
+  so.torque_noise_std = 0.05 * g_torque_noise;
+  so.seed = seed;
+  Sensors sensors(model, so);
+  ClosedLoopOptions lo;
+  lo.periods = 2;
+  const ClosedLoopResult r =
+      run_closed_loop(multisine(n, 10.0, ts, seed), pid, *plant, sensors, lo);
+  return JointRecord{r.t, r.q, {}, {}, r.tau};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc > 1) g_noise = std::atof(argv[1]);
+  if (argc > 2) g_torque_noise = std::atof(argv[2]);
+  Model model = load_robot("puma560");
+  for (int j = 0; j < model.dof(); ++j) {
+    model.joints[j].friction = {0.05 * (j + 1), 0.5 + 0.1 * j, 0.3 + 0.1 * j, 0.1 * (j + 1)};
+  }
+  const double ts = 1e-3;
+  const JointRecord a = run(model, 1, ts), b = run(model, 2, ts);
+  IdentifyOptions def;
+  def.signal.torque_time_offset = 0.5 * ts;  // the logged torque is held for one period
+  const IdentificationResult diff = identify(model, a, def);
+  const double diff_err =
+      validate_torques(model, b, diff.names, diff.estimate.x, def).relative_error_all;
+  std::printf("differential model (identify defaults): %.2f %% on run B\n", 100 * diff_err);
+  const BaseParameters& base = diff.base;
+  const Eigen::VectorXd truth = base.reduce(def.layout.parameters(model));
+  std::printf("truth on run B: %.3f %%\n",
+              100 * validate_torques(model, b, base.names, truth, def).relative_error_all);
+  std::printf("cutoff_hz decimate interval_ms weight power long | error_B_%%\n");
+  for (double cutoff : kCutoffs) {
+    for (int decimate : {0, 1}) {
+      if (cutoff < 0 && decimate == 0) continue;
+      SignalOptions so = def.signal;
+      so.filter = cutoff >= 0.0;
+      so.cutoff_hz = std::max(cutoff, 0.0);
+      so.decimate = decimate;
+      std::vector<std::pair<std::string, std::string>> choices;
+      ProcessedRecord p;
+      try {
+        p = preprocess(a, so, choices);
+      } catch (const std::exception& e) {
+        std::printf("%g %d: %s\n", cutoff, decimate, e.what());
+        continue;
+      }
+      for (double interval_ms : kIntervalsMs) {
+        for (int power = 0; power < 2; ++power) {
+          // power 0: Simpson on the processed τᵀq̇; 1: the raw held torque's work Σ τ_kᵀΔq_k
+          // (zero-order hold on the unfiltered log, no velocity), energy side processed.
+          if (power == 1 && decimate != 1) continue;
+          for (bool weight : {false, true}) {
+            for (bool long_integrals : {false, true}) {
+              if (long_integrals && weight) continue;
+              IntegralOptions io;
+              io.interval = 1e-3 * interval_ms;
+              io.weight_rows = false;
+              io.long_integrals = long_integrals;
+              try {
+                EquationBlock blk = integral_equations(model, def.layout, false, p, io);
+                if (power == 1) {
+                  for (Eigen::Index i = 0; i < blk.y.size(); ++i) {
+                    const Eigen::Index e = std::llround(blk.t[i] / ts);
+                    const Eigen::Index steps = std::max<Eigen::Index>(
+                        1, interval_ms > 0 ? std::llround(interval_ms * 1e-3 / ts) : 2);
+                    const Eigen::Index s0 =
+                        long_integrals ? std::llround(p.record.t[0] / ts) : e - steps;
+                    double y = 0.0;
+                    for (Eigen::Index k = s0; k < e; ++k)
+                      y += a.tau.row(k).dot(a.q.row(k + 1) - a.q.row(k));
+                    blk.y[i] = y;
+                  }
+                }
+                if (weight) {
+                  IntegralOptions wo = io;
+                  wo.weight_rows = true;
+                  const EquationBlock w = integral_equations(model, def.layout, false, p, wo);
+                  for (Eigen::Index i = 0; i < blk.y.size(); ++i) {
+                    const double f = w.W.row(i).norm() / blk.W.row(i).norm();
+                    blk.W.row(i) *= f;
+                    blk.y[i] *= f;
+                  }
+                }
+                const Estimate e = ordinary_least_squares(base.select(blk.W), blk.y);
+                const double err =
+                    validate_torques(model, b, base.names, e.x, def).relative_error_all;
+                std::printf("%6.1f %2d(%4.0fHz) %6.1f %d %s %d | %7.2f\n",
+                            cutoff < 0 ? -1.0 : p.cutoff_hz, decimate, p.rate_hz, interval_ms,
+                            weight, power ? "raw-zoh" : "simpson", long_integrals, 100 * err);
+              } catch (const std::exception& e) {
+                std::printf("%6.1f %2d %6.1f: %s\n", cutoff, decimate, interval_ms, e.what());
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  return 0;
+}
