@@ -141,6 +141,8 @@ TEST(IntegralEquations, NoiseFreeShortIntegralsRecoverBaseParameters) {
   const Estimate e = ordinary_least_squares(r.base.select(b.W), b.y);
   ASSERT_EQ(e.summary.rank, r.base.rank);  // the data excite every base parameter
   const double scale = r.truth.cwiseAbs().maxCoeff();
+  std::cout << "largest error / largest parameter: zero-order hold "
+            << (e.x - r.truth).cwiseAbs().maxCoeff() / scale;
   for (int i = 0; i < r.base.rank; ++i) {
     EXPECT_NEAR(e.x[i], r.truth[i], 1e-6 * scale) << r.base.names[i];
   }
@@ -154,6 +156,8 @@ TEST(IntegralEquations, NoiseFreeShortIntegralsRecoverBaseParameters) {
   const EquationBlock s =
       integral_equations(r.model, r.layout, false, truth_record(r.run, r.ts), o);
   const Estimate es = ordinary_least_squares(r.base.select(s.W), s.y);
+  std::cout << ", long " << (el.x - r.truth).cwiseAbs().maxCoeff() / scale << ", Simpson "
+            << (es.x - r.truth).cwiseAbs().maxCoeff() / scale << "\n";
   EXPECT_GT((es.x - r.truth).cwiseAbs().maxCoeff(), 1e-4 * scale);
 }
 
