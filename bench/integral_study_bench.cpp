@@ -10,71 +10,33 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <random>
 #include <vector>
 
+#include "../tests/estimation/integral_support.hpp"
 #include "dynid/estimation/identification.hpp"
 #include "dynid/estimation/integral_equations.hpp"
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/model/robots.hpp"
-#include "dynid/sim/closed_loop.hpp"
-#include "dynid/sim/pid_controller.hpp"
-#include "dynid/sim/plant.hpp"
-#include "dynid/sim/sensors.hpp"
 
 namespace {
 
 using namespace dynid;
-
-Reference multisine(int n, double duration, double ts, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const Eigen::Index m = std::llround(duration / ts);
-  Reference r;
-  r.t = Eigen::VectorXd::LinSpaced(m, 0.0, (m - 1) * ts);
-  r.q.setZero(m, n);
-  r.dq.setZero(m, n);
-  r.ddq.setZero(m, n);
-  for (int j = 0; j < n; ++j) {
-    for (int k = 1; k <= 5; ++k) {
-      const double w = 2 * M_PI * k / duration, a = 1.0 * u(rng) / k, phi = M_PI * u(rng);
-      for (Eigen::Index i = 0; i < m; ++i) {
-        const double s = std::sin(w * r.t[i] + phi), c = std::cos(w * r.t[i] + phi);
-        r.q(i, j) += a * s;
-        r.dq(i, j) += a * w * c;
-        r.ddq(i, j) -= a * w * w * s;
-      }
-    }
-  }
-  return r;
-}
 
 double g_noise = 1.0, g_torque_noise = 1.0;
 // The grid (cut-off < 0: no filter; interval 0: automatic).
 const std::vector<double> kCutoffs = {0.0, 2.0, 5.0, 10.0, 20.0, 40.0, 80.0, -1.0};
 const std::vector<double> kIntervalsMs = {0.0, 5.0, 10.0, 50.0, 100.0, 200.0, 500.0, 1000.0};
 
+// The closed-loop run of the tests (tests/estimation/integral_support.hpp): PID + computed-torque
+// feed-forward tracking one multi-sine period twice.
 JointRecord run(const Model& model, unsigned seed, double ts) {
-  const int n = model.dof();
-  PidOptions po;
-  po.kp = Eigen::VectorXd::Constant(n, 400.0);
-  po.kd = Eigen::VectorXd::Constant(n, 40.0);
-  po.sample_time = ts;
-  po.feed_forward = FeedForward::kComputedTorque;
-  po.effort_limit = Eigen::VectorXd::Constant(n, 1e6);
-  PidController pid(model, po);
-  PlantOptions p;
-  p.dt = ts;
-  auto plant = make_plant(model, p);
   SensorOptions so;
   so.position_noise_std = 1e-4 * g_noise;
   so.torque_noise_std = 0.05 * g_torque_noise;
   so.seed = seed;
-  Sensors sensors(model, so);
-  ClosedLoopOptions lo;
-  lo.periods = 2;
-  const ClosedLoopResult r =
-      run_closed_loop(multisine(n, 10.0, ts, seed), pid, *plant, sensors, lo);
+  const ClosedLoopResult r = integral_testing::simulate(
+      model, integral_testing::multisine(model.dof(), 10.0, ts, seed, 1.0), ts, so, PlantOptions{},
+      2);
   return JointRecord{r.t, r.q, {}, {}, r.tau};
 }
 

@@ -1,10 +1,10 @@
 #include "dynid/estimation/integral_equations.hpp"
 
 #include <cmath>
-#include <sstream>
 #include <string>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/dynamics/workspace.hpp"
 #include "dynid/model/transmission.hpp"
 #include "dynid/regressor/energy_regressor.hpp"
@@ -12,12 +12,6 @@
 namespace dynid {
 
 namespace {
-
-std::string fmt(double x) {
-  std::ostringstream s;
-  s << x;
-  return s.str();
-}
 
 void check_processed(const Model& model, const JointRecord& r) {
   const int n = model.dof();
@@ -55,20 +49,21 @@ EquationBlock integral_equations(const Model& model, const ParameterLayout& layo
   const double duration = r.t[m - 1] - r.t[0];
   const double step = duration / static_cast<double>(m - 1);
   if (!(options.interval >= 0.0) || !std::isfinite(options.interval)) {
-    throw UsageError("integral interval " + fmt(options.interval) +
+    throw UsageError("integral interval " + short_number(options.interval) +
                      " s is not a length; give a positive number of seconds (0 = automatic)");
   }
   const Eigen::Index steps = options.interval == 0.0
                                  ? kAutoIntervalSteps
                                  : static_cast<Eigen::Index>(std::llround(options.interval / step));
   if (steps < 1) {
-    throw UsageError("integral interval " + fmt(options.interval) +
+    throw UsageError("integral interval " + short_number(options.interval) +
                      " s is shorter than two samples of the processed run (one step is " +
-                     fmt(step) + " s); give at least " + fmt(step) + " s");
+                     short_number(step) + " s); give at least " + short_number(step) + " s");
   }
   if (steps > m - 1) {
-    throw UsageError("integral interval " + fmt(options.interval) + " s is longer than the run (" +
-                     fmt(duration) + " s after processing); give at most " + fmt(duration) + " s");
+    throw UsageError("integral interval " + short_number(options.interval) +
+                     " s is longer than the run (" + short_number(duration) +
+                     " s after processing); give at most " + short_number(duration) + " s");
   }
   // A run in which no joint moves beyond its position noise carries no energy information.
   bool moves = false;
