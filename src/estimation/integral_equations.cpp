@@ -8,6 +8,7 @@
 #include "dynid/dynamics/workspace.hpp"
 #include "dynid/model/transmission.hpp"
 #include "dynid/regressor/energy_regressor.hpp"
+#include "regressor/friction_work.hpp"
 
 namespace dynid {
 
@@ -117,8 +118,6 @@ EquationBlock integral_equations(const Model& model, const ParameterLayout& layo
   if (options.rule != IntegrationRule::kZeroOrderHold) {
     power = (r.tau.array() * r.dq.array()).rowwise().sum();
   }
-  // Column of the first friction term of joint j (after its armature column, joint_columns order).
-  const int friction_first = layout.armature ? 1 : 0;
   Eigen::VectorXd square(n);  // per-joint ∫q̇_j² of one step, reused by the coupled motors
   energy_row(0, h_prev);
   for (Eigen::Index i = 0; i < intervals; ++i) {
@@ -139,21 +138,7 @@ EquationBlock integral_equations(const Model& model, const ParameterLayout& layo
         const StepVelocityIntegrals s =
             step_velocity_integrals(hk, r.q(k + 1, j) - r.q(k, j), r.dq(k, j), r.dq(k + 1, j));
         square[j] = s.positive_square + s.negative_square;
-        Eigen::Index c = kLinkParams * n + jc * j + friction_first;
-        if (layout.asymmetric) {
-          if (layout.viscous) {
-            w[c++] += s.positive_square;
-            w[c++] += s.negative_square;
-          }
-          if (layout.coulomb) {
-            w[c++] += s.positive;
-            w[c++] -= s.negative;
-          }
-        } else {
-          if (layout.viscous) w[c++] += square[j];
-          if (layout.coulomb) w[c++] += s.positive - s.negative;
-        }
-        if (layout.offset) w[c++] += s.positive + s.negative;
+        detail::add_friction_work(layout, s, w.segment(kLinkParams * n + jc * j, jc));
       }
       for (size_t c = 0; c < motors.size(); ++c) {
         const Eigen::RowVectorXd& nk = n_k[c];
