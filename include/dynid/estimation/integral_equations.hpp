@@ -27,7 +27,8 @@ struct IntegralOptions {
   /// puts into it, √(Σ_k h_k²‖q̇_k‖²) over the interval's steps, normalised to RMS 1 over the
   /// block (y stays in joules on average): a fast interval's power integral carries more torque
   /// noise than a slow one's, and unweighted OLS intervals then miss the truth (measured in
-  /// docs/methods/estimation.md, "Integral model").
+  /// docs/methods/estimation.md, "Integral model"). Short integrals only: long rows share their
+  /// start and are left unweighted.
   bool weight_rows = true;
 };
 
@@ -47,7 +48,8 @@ inline constexpr int kAutoIntervalSteps = 2;
 /// power uses options.rule; the friction integrals use step_velocity_integrals on every step
 /// (exact when q is a cubic over the step). No acceleration is used.
 /// Units: y [J], columns [J per parameter unit] (times the row weight of options.weight_rows).
-/// Block: group 0 = "energy" for every row, sample = interval index, t = interval end [s]. Throws
+/// Block: ⌊(m − 1)/steps⌋ rows (m samples, `steps` per interval) × the named columns; group 0 =
+/// "energy" for every row, sample = interval index, t = interval end [s]. Throws
 /// dynid::UsageError for an interval shorter than one step (two samples) or longer than the run;
 /// dynid::Error for a record whose sizes do not match the model, without torques, or in which no
 /// joint moves beyond its position noise.
