@@ -1,5 +1,6 @@
 // Integral-model equations (integral_equations) for 10⁵ and 10⁶ samples of the 7-DoF iiwa14 at
-// 1 kHz, full friction layout, 10 ms intervals (issue 11 item 8): samples per second of the
+// 1 kHz, full friction layout, default options (10 ms intervals, endpoint-momentum row
+// weights) (issue 11 item 8): samples per second of the
 // equations stage alone (the run is an in-memory processed record; reading and filtering are
 // measured by identification_bench). Run: ./build/bench/integral_bench
 #include <cmath>
@@ -18,6 +19,7 @@ dynid::ProcessedRecord record(int n, long samples) {
   p.record.q.resize(samples, n);
   p.record.dq.resize(samples, n);
   p.record.tau.resize(samples, n);
+  p.velocity_noise_std = Eigen::VectorXd::Constant(n, 1e-3);  // enables the momentum weights
   for (long k = 0; k < samples; ++k) {
     const double t = 1e-3 * k;
     p.record.t[k] = t;

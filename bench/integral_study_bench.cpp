@@ -61,7 +61,9 @@ int main(int argc, char** argv) {
   const Eigen::VectorXd truth = base.reduce(def.layout.parameters(model));
   std::printf("truth on run B: %.3f %%\n",
               100 * validate_torques(model, b, base.names, truth, def).relative_error_all);
-  std::printf("cutoff_hz decimate interval_ms weight power long | error_B_%%\n");
+  std::printf(
+      "cutoff_hz decimate interval_ms weight(0 none, 1 torque, 2 momentum) power long | "
+      "error_B_%%\n");
   for (double cutoff : kCutoffs) {
     for (int decimate : {0, 1}) {
       if (cutoff < 0 && decimate == 0) continue;
@@ -82,12 +84,12 @@ int main(int argc, char** argv) {
           // power 0: Simpson on the processed τᵀq̇; 1: the raw held torque's work Σ τ_kᵀΔq_k
           // (zero-order hold on the unfiltered log, no velocity), energy side processed.
           if (power == 1 && decimate != 1) continue;
-          for (bool weight : {false, true}) {
+          for (int weight : {0, 1, 2}) {  // IntegralWeighting: none, torque noise, momentum
             for (bool long_integrals : {false, true}) {
               if (long_integrals && weight) continue;
               IntegralOptions io;
               io.interval = 1e-3 * interval_ms;
-              io.weight_rows = false;
+              io.weighting = IntegralWeighting::kNone;
               io.long_integrals = long_integrals;
               try {
                 EquationBlock blk = integral_equations(model, def.layout, false, p, io);
@@ -106,7 +108,7 @@ int main(int argc, char** argv) {
                 }
                 if (weight) {
                   IntegralOptions wo = io;
-                  wo.weight_rows = true;
+                  wo.weighting = static_cast<IntegralWeighting>(weight);
                   const EquationBlock w = integral_equations(model, def.layout, false, p, wo);
                   for (Eigen::Index i = 0; i < blk.y.size(); ++i) {
                     const double f = w.W.row(i).norm() / blk.W.row(i).norm();

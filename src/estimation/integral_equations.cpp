@@ -5,6 +5,7 @@
 
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
+#include "dynid/dynamics/rnea.hpp"
 #include "dynid/dynamics/workspace.hpp"
 #include "dynid/model/transmission.hpp"
 #include "dynid/regressor/energy_regressor.hpp"
@@ -34,6 +35,53 @@ void check_processed(const Model& model, const JointRecord& r) {
     if (!(r.t[k + 1] > r.t[k])) {
       throw Error("integral model: time stamps must increase strictly (sample " +
                   std::to_string(k + 1) + ")");
+    }
+  }
+}
+
+// Divides the rows of `b` by the relative std of their errors under `weighting`
+// (IntegralWeighting).
+void weight_rows(const Model& model, const JointRecord& r, const Eigen::VectorXd& velocity_noise,
+                 Eigen::Index steps, IntegralWeighting weighting, EquationBlock& b) {
+  const Eigen::Index rows = b.y.size();
+  const int n = model.dof();
+  const bool momentum = weighting == IntegralWeighting::kEndpointMomentum &&
+                        velocity_noise.size() == n && velocity_noise.maxCoeff() > 0.0;
+  Eigen::VectorXd scale(rows);
+  if (momentum) {
+    // Momentum M(q)·q̇ by RNEA with q̈ := q̇ and no velocity, gravity or joint terms (O(n) per
+    // end, not the O(n²) mass matrix), plus the armature's Ia·q̇.
+    Workspace ws(model);
+    Eigen::VectorXd p(n), zero = Eigen::VectorXd::Zero(n), end_variance(rows + 1);
+    RneaOptions inertial;
+    inertial.gravity = false;
+    inertial.joint_terms = false;
+    for (Eigen::Index i = 0; i <= rows; ++i) {
+      const Eigen::Index k = i * steps;
+      rnea(model, ws, r.q.row(k).transpose(), zero, r.dq.row(k).transpose(), p, inertial);
+      for (int j = 0; j < n; ++j) p[j] += model.joints[j].friction.Ia * r.dq(k, j);
+      end_variance[i] = (p.array().square() * velocity_noise.array().square()).sum();
+    }
+    for (Eigen::Index i = 0; i < rows; ++i)
+      scale[i] = std::sqrt(end_variance[i] + end_variance[i + 1]);
+  } else {
+    for (Eigen::Index i = 0; i < rows; ++i) {
+      double s2 = 0.0;
+      for (Eigen::Index k = i * steps; k < (i + 1) * steps; ++k) {
+        const double hk = r.t[k + 1] - r.t[k];
+        s2 += hk * hk * r.dq.row(k).squaredNorm();
+      }
+      scale[i] = std::sqrt(s2);
+    }
+  }
+  const double rms = std::sqrt(scale.squaredNorm() / static_cast<double>(rows));
+  if (!(rms > 0.0)) return;
+  // A row without motion carries no noise model and no information: leave it.
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    const double s = scale[i] / rms;
+    if (s > 1e-6) {
+      b.W.row(i) /= s;
+      b.y[i] /= s;
     }
   }
 }
@@ -154,25 +202,8 @@ EquationBlock integral_equations(const Model& model, const ParameterLayout& layo
     b.t[i] = r.t[e];
     std::swap(h_prev, h_next);
   }
-  if (options.weight_rows && !options.long_integrals) {
-    Eigen::VectorXd scale(intervals);
-    for (Eigen::Index i = 0; i < intervals; ++i) {
-      double s2 = 0.0;
-      for (Eigen::Index k = i * steps; k < (i + 1) * steps; ++k) {
-        const double hk = r.t[k + 1] - r.t[k];
-        s2 += hk * hk * r.dq.row(k).squaredNorm();
-      }
-      scale[i] = std::sqrt(s2);
-    }
-    const double rms = std::sqrt(scale.squaredNorm() / static_cast<double>(intervals));
-    // An interval without motion carries no torque-noise work and no information: leave it.
-    for (Eigen::Index i = 0; i < intervals; ++i) {
-      const double s = scale[i] / rms;
-      if (s > 1e-6) {
-        b.W.row(i) /= s;
-        b.y[i] /= s;
-      }
-    }
+  if (options.weighting != IntegralWeighting::kNone && !options.long_integrals) {
+    weight_rows(model, r, processed.velocity_noise_std, steps, options.weighting, b);
   }
   if (options.long_integrals) {
     // Seed 1 §IV: [t0, t_b] for every interval end t_b; energy differences telescope and the

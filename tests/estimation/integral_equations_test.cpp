@@ -65,7 +65,7 @@ TEST(IntegralEquations, RowsAreTheIntegratedPowerOfTheTorqueRegressor) {
   for (const ParameterLayout& layout : {ParameterLayout::full(), asym}) {
     IntegralOptions o;
     o.interval = 5 * ts;
-    o.weight_rows = false;  // the oracle is the unweighted power integral
+    o.weighting = IntegralWeighting::kNone;  // the oracle is the unweighted power integral
     const EquationBlock b = integral_equations(model, layout, true, p, o);
     ASSERT_EQ(b.W.rows(), (m - 1) / 5);
     ASSERT_EQ(b.columns, stacked_regressor_names(model, layout, true));

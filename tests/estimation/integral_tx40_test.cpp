@@ -76,13 +76,13 @@ double value(const Tx40Integral& r, const std::string& name) {
   return it == r.base.names.end() ? NAN : r.estimate.x[it - r.base.names.begin()];
 }
 
-// What the integral model gets on this run (issue 11 item 7; numbers in
-// docs/methods/estimation.md, "Integral model"): the energy equations are fitted to 3.8 %, but the
-// friction is within 10 % of the published values only for Fc1, Fv2, Fvm6 and Fcm6; Fc3 and Fc6
-// come out with the wrong sign and the torque prediction is ~9× worse than the differential
-// model's. One scalar equation per interval sums the power of all six joints, so the small
-// joints' friction is weakly determined. The test pins these numbers so that a change to the
-// builder or the defaults that moves them is seen.
+// What the integral model gets on this run with its defaults (issue 11 item 7; numbers in
+// docs/methods/estimation.md, "Integral model"): the friction is within 10 % of the published
+// values only for Fv1 (Fv2, Fv5 and Fvm6 within 13 %); Fc3, Fc4 and Fc6 come out with the wrong
+// sign, and the torque prediction is ~8× worse than the differential model's. One scalar
+// equation per interval sums the power of all six joints, so the small joints' friction is
+// weakly determined. The test pins these numbers so that a change to the builder or the
+// defaults that moves them is seen.
 TEST(IntegralTx40, FrictionAgainstPublishedValues) {
   const Tx40Integral* r = data();
   if (r == nullptr) GTEST_SKIP() << "data set not found at " << kData;
@@ -99,14 +99,11 @@ TEST(IntegralTx40, FrictionAgainstPublishedValues) {
   const double fvm = r->published["fvm6"].as<double>(), fsm = r->published["fsm6"].as<double>();
   std::cout << "Fvm6 " << value(*r, "Fvm6") << " (published " << fvm << "), Fcm6 "
             << value(*r, "Fcm6") << " (published " << fsm << ")\n";
-  EXPECT_NEAR(value(*r, "Fv2"), r->published["fv"][1].as<double>(),
-              0.1 * r->published["fv"][1].as<double>());
-  EXPECT_NEAR(value(*r, "Fc1"), r->published["fs"][0].as<double>(),
-              0.1 * r->published["fs"][0].as<double>());
-  EXPECT_NEAR(value(*r, "Fvm6"), fvm, 0.1 * fvm);
-  EXPECT_NEAR(value(*r, "Fcm6"), fsm, 0.1 * fsm);
-  EXPECT_EQ(within, 2) << "of the 12 joint friction values within 10 %";
-  EXPECT_LT(r->estimate.relative_error, 0.045);
+  EXPECT_NEAR(value(*r, "Fv1"), r->published["fv"][0].as<double>(),
+              0.1 * r->published["fv"][0].as<double>());
+  EXPECT_EQ(within, 1) << "of the 12 joint friction values within 10 %";
+  std::cout << "energy equations: relative error " << r->estimate.relative_error << "\n";
+  EXPECT_LT(r->estimate.relative_error, 0.05);
 }
 
 TEST(IntegralTx40, TorqueValidationBesideTheDifferentialModel) {

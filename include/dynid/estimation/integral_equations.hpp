@@ -8,6 +8,21 @@
 
 namespace dynid {
 
+/// Row weighting of the integral model: each row is divided by the relative standard deviation
+/// of its error under one noise model, normalised to RMS 1 over the block (y stays in joules on
+/// average). Measurements in docs/methods/estimation.md, "Integral model".
+enum class IntegralWeighting {
+  kNone,  ///< rows as they are
+  /// White torque noise: work of std ∝ √(Σ_k h_k²‖q̇_k‖²) over the interval's steps (fast
+  /// intervals are noisier; unweighted OLS intervals then miss the truth).
+  kTorqueNoise,
+  /// Velocity noise at the interval ends entering the kinetic energy: std ∝
+  /// √(Σ_j σ_q̇j²((M q̇)_a,j² + (M q̇)_b,j²)), M the mass matrix of the given (nominal) model with
+  /// armature, σ_q̇ the processed record's velocity_noise_std. Falls back to kTorqueNoise when
+  /// the record carries no velocity noise estimate (all zero or absent).
+  kEndpointMomentum,
+};
+
 /// Options of integral_equations() (seed 1 eqs. 8–18, 32–35; docs/methods/estimation.md,
 /// "Integral model").
 struct IntegralOptions {
@@ -23,13 +38,9 @@ struct IntegralOptions {
   /// Quadrature of the actuator power τᵀq̇ (IntegrationRule). kZeroOrderHold integrates a torque
   /// held from one sample to the next exactly, as τ_kᵀ(q_{k+1} − q_k) (no velocity needed).
   IntegrationRule rule = IntegrationRule::kSimpson;
-  /// Divide each row by the relative standard deviation of the work that white torque noise
-  /// puts into it, √(Σ_k h_k²‖q̇_k‖²) over the interval's steps, normalised to RMS 1 over the
-  /// block (y stays in joules on average): a fast interval's power integral carries more torque
-  /// noise than a slow one's, and unweighted OLS intervals then miss the truth (measured in
-  /// docs/methods/estimation.md, "Integral model"). Short integrals only: long rows share their
-  /// start and are left unweighted.
-  bool weight_rows = true;
+  /// How the short-integral rows are weighted (IntegralWeighting). Long rows share their start
+  /// and are left unweighted.
+  IntegralWeighting weighting = IntegralWeighting::kEndpointMomentum;
 };
 
 /// Steps per interval when IntegralOptions::interval is 0 (the shortest interval on which
@@ -47,7 +58,7 @@ inline constexpr int kAutoIntervalSteps = 2;
 /// layout, coupling), so base parameters and names are those of the differential model. The
 /// power uses options.rule; the friction integrals use step_velocity_integrals on every step
 /// (exact when q is a cubic over the step). No acceleration is used.
-/// Units: y [J], columns [J per parameter unit] (times the row weight of options.weight_rows).
+/// Units: y [J], columns [J per parameter unit] (times the row weight of options.weighting).
 /// Block: ⌊(m − 1)/steps⌋ rows (m samples, `steps` per interval) × the named columns; group 0 =
 /// "energy" for every row, sample = interval index, t = interval end [s]. Throws
 /// dynid::UsageError for an interval shorter than one step (two samples) or longer than the run;
@@ -59,7 +70,7 @@ EquationBlock integral_equations(const Model& model, const ParameterLayout& layo
 
 /// Signal processing for the integral model (preprocess()): the differential defaults except a
 /// fixed 10 Hz cut-off (the automatic rule, tuned for q̈, chose 1.1 Hz on a simulated run and the
-/// filter's distortion of τᵀq̇ then dominated: 56 % torque error against 24 % at 10 Hz) and no
+/// filter's distortion of τᵀq̇ then dominated: 50 % torque error against 12 % at 10 Hz) and no
 /// decimation (the power is integrated at the full rate). Measurements in
 /// docs/methods/estimation.md, "Integral model".
 SignalOptions integral_signal_options();
