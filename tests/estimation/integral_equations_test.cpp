@@ -9,6 +9,7 @@
 #include <Eigen/QR>
 
 #include "dynid/common/error.hpp"
+#include "dynid/dynamics/mass_matrix.hpp"
 #include "dynid/estimation/integral_equations.hpp"
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/recursive_least_squares.hpp"
@@ -300,6 +301,46 @@ TEST(IntegralEquations, BadInputIsOneClearError) {
   ProcessedRecord no_tau = p;
   no_tau.record.tau.resize(0, 0);
   EXPECT_THROW(integral_equations(r.model, r.layout, false, no_tau, {}), Error);
+}
+
+// The default row weights follow the endpoint-momentum noise model: row i of the weighted block is
+// the unweighted row divided by s_i/rms(s), s_i² = Σ_j σ_j²((M q̇)_a,j² + (M q̇)_b,j²), with M from
+// mass_matrix (the builder computes M q̇ by RNEA). Without a velocity noise estimate the rows are
+// weighted for torque noise instead.
+TEST(IntegralEquations, EndpointMomentumWeightsFollowTheMassMatrix) {
+  const PumaRun& r = puma();
+  ProcessedRecord p = truth_record(r.run, r.ts);
+  p.velocity_noise_std = Eigen::VectorXd::LinSpaced(r.model.dof(), 1e-3, 6e-3);
+  IntegralOptions o;
+  o.weighting = IntegralWeighting::kNone;
+  const EquationBlock plain = integral_equations(r.model, r.layout, false, p, o);
+  o.weighting = IntegralWeighting::kEndpointMomentum;
+  const EquationBlock weighted = integral_equations(r.model, r.layout, false, p, o);
+  const Eigen::Index steps = 20, rows = plain.y.size();  // 10 ms at 2 kHz
+  Workspace ws(r.model);
+  Eigen::MatrixXd M(r.model.dof(), r.model.dof());
+  auto end_variance = [&](Eigen::Index k) {
+    mass_matrix(r.model, ws, p.record.q.row(k).transpose(), M);
+    const Eigen::VectorXd mom = M * p.record.dq.row(k).transpose();
+    return (mom.array().square() * p.velocity_noise_std.array().square()).sum();
+  };
+  Eigen::VectorXd s(rows);
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    s[i] = std::sqrt(end_variance(i * steps) + end_variance((i + 1) * steps));
+  }
+  s /= std::sqrt(s.squaredNorm() / static_cast<double>(rows));
+  for (Eigen::Index i = 0; i < rows; i += 37) {
+    EXPECT_NEAR(weighted.y[i], plain.y[i] / s[i], 1e-9 * std::abs(plain.y[i] / s[i])) << i;
+    EXPECT_LT((weighted.W.row(i) - plain.W.row(i) / s[i]).norm(),
+              1e-9 * plain.W.row(i).norm() / s[i])
+        << i;
+  }
+  p.velocity_noise_std.resize(0);
+  o.weighting = IntegralWeighting::kTorqueNoise;
+  const EquationBlock torque = integral_equations(r.model, r.layout, false, p, o);
+  o.weighting = IntegralWeighting::kEndpointMomentum;
+  const EquationBlock fallback = integral_equations(r.model, r.layout, false, p, o);
+  EXPECT_EQ(fallback.y, torque.y);
 }
 
 }  // namespace
