@@ -23,6 +23,7 @@ namespace dynid {
 namespace {
 
 using integral_testing::base_of;
+using integral_testing::estimate_with_intervals;
 using integral_testing::multisine;
 using integral_testing::simulate;
 using integral_testing::truth_record;
@@ -160,18 +161,6 @@ TEST(IntegralEquations, NoiseFreeShortIntegralsRecoverBaseParameters) {
   std::cout << ", long " << (el.x - r.truth).cwiseAbs().maxCoeff() / scale << ", Simpson "
             << (es.x - r.truth).cwiseAbs().maxCoeff() / scale << "\n";
   EXPECT_GT((es.x - r.truth).cwiseAbs().maxCoeff(), 1e-4 * scale);
-}
-
-// Estimates and intervals as identify() computes them: OLS on the base columns, then the HAC
-// sandwich over the block's samples (intervals).
-Estimate estimate_with_intervals(const EquationBlock& b, const BaseParameters& base) {
-  const Eigen::MatrixXd Wb = base.select(b.W);
-  EstimationOptions eo;
-  eo.names = base.names;
-  Estimate e = ordinary_least_squares(Wb, b.y, b.group, eo);
-  const Eigen::VectorXd res = b.y - Wb * e.x;
-  apply_hac_covariance(e, Wb, res, b.sample, eo);
-  return e;
 }
 
 // White torque-sensor noise (σ = 0.3 N·m) on the held torque, true positions and velocities:

@@ -53,13 +53,8 @@ Estimate integral_estimate(const Model& model, const ParameterLayout& layout,
                            bool long_integrals) {
   IntegralOptions o;
   o.long_integrals = long_integrals;
-  const EquationBlock b = integral_equations(model, layout, true, p, o);
-  const Eigen::MatrixXd Wb = base.select(b.W);
-  EstimationOptions eo;
-  eo.names = base.names;
-  Estimate e = ordinary_least_squares(Wb, b.y, b.group, eo);
-  apply_hac_covariance(e, Wb, b.y - Wb * e.x, b.sample, eo);
-  return e;
+  return integral_testing::estimate_with_intervals(integral_equations(model, layout, true, p, o),
+                                                   base);
 }
 
 const Irp6Results& results() {

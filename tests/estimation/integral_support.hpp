@@ -8,7 +8,10 @@
 
 #include <Eigen/Core>
 
+#include "dynid/estimation/equation_block.hpp"
 #include "dynid/estimation/identification.hpp"
+#include "dynid/estimation/least_squares.hpp"
+#include "dynid/estimation/statistics.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
 #include "dynid/model/model.hpp"
 #include "dynid/sim/closed_loop.hpp"
@@ -85,6 +88,18 @@ inline BaseParameters base_of(const Model& model, const ParameterLayout& layout,
   o.layout = layout;
   o.coupling = coupling;
   return compute_base_parameters(model, o);
+}
+
+/// Estimate and intervals of a block as identify() computes them: OLS on the base columns, then the
+/// HAC sandwich over the block's samples.
+inline Estimate estimate_with_intervals(const EquationBlock& b, const BaseParameters& base) {
+  const Eigen::MatrixXd Wb = base.select(b.W);
+  EstimationOptions eo;
+  eo.names = base.names;
+  Estimate e = ordinary_least_squares(Wb, b.y, b.group, eo);
+  const Eigen::VectorXd res = b.y - Wb * e.x;
+  apply_hac_covariance(e, Wb, res, b.sample, eo);
+  return e;
 }
 
 }  // namespace dynid::integral_testing

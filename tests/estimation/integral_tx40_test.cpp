@@ -13,6 +13,7 @@
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/model/transmission.hpp"
+#include "estimation/integral_support.hpp"
 
 namespace dynid {
 namespace {
@@ -49,12 +50,8 @@ const Tx40Integral* load() {
   bo.layout = io.layout;
   bo.coupling = true;
   r->base = compute_base_parameters(r->model, bo);
-  const EquationBlock b = integral_equations(r->model, io.layout, true, p, IntegralOptions{});
-  const Eigen::MatrixXd Wb = r->base.select(b.W);
-  EstimationOptions eo;
-  eo.names = r->base.names;
-  r->estimate = ordinary_least_squares(Wb, b.y, b.group, eo);
-  apply_hac_covariance(r->estimate, Wb, b.y - Wb * r->estimate.x, b.sample, eo);
+  r->estimate = integral_testing::estimate_with_intervals(
+      integral_equations(r->model, io.layout, true, p, IntegralOptions{}), r->base);
   // Torque prediction on the run with the default (differential) processing, as dynid validate.
   r->integral_validation =
       validate_torques(r->model, r->record, r->base.names, r->estimate.x, IdentifyOptions{});
