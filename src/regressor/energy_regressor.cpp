@@ -3,7 +3,7 @@
 #include <cassert>
 
 #include "dynid/dynamics/kinematics.hpp"
-#include "regressor/joint_columns.hpp"
+#include "regressor/friction_work.hpp"
 
 namespace dynid {
 
@@ -47,21 +47,17 @@ void integral_regressor(const Model& model, Workspace& ws, const ParameterLayout
   Eigen::VectorXd h_begin(p);
   energy_regressor(model, ws, layout, q.row(0).transpose(), dq.row(0).transpose(), h_begin);
   d -= h_begin;
-  // Seed 1 eqs. 15–17: friction work ∫ (friction column)·dq_j dt; armature is in H already, so
-  // its work column is not added again. y = ∫ tauᵀ dq dt. Trapezoidal rule on the samples.
+  // Seed 1 eqs. 15–17: friction work per step from the quadratic velocity through the step's
+  // end velocities and position change (exact for cubic q, split at reversals); armature is in
+  // H already. y = ∫ tauᵀ dq dt by the trapezoidal rule.
   y = 0.0;
-  Eigen::VectorXd cols_a(jc), cols_b(jc);
   for (Eigen::Index k = 0; k + 1 < m; ++k) {
     const double dt = t[k + 1] - t[k];
     y += 0.5 * dt * (tau.row(k).dot(dq.row(k)) + tau.row(k + 1).dot(dq.row(k + 1)));
     for (int j = 0; j < n; ++j) {
-      detail::joint_columns(layout, dq(k, j), 0.0, cols_a);
-      detail::joint_columns(layout, dq(k + 1, j), 0.0, cols_b);
-      const int first = layout.armature ? 1 : 0;
-      for (int c = first; c < jc; ++c) {
-        d[kLinkParams * n + jc * j + c] +=
-            0.5 * dt * (cols_a[c] * dq(k, j) + cols_b[c] * dq(k + 1, j));
-      }
+      detail::add_friction_work(
+          layout, step_velocity_integrals(dt, q(k + 1, j) - q(k, j), dq(k, j), dq(k + 1, j)),
+          d.segment(kLinkParams * n + jc * j, jc));
     }
   }
 }

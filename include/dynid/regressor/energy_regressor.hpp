@@ -16,8 +16,9 @@ void energy_regressor(const Model& model, Workspace& ws, const ParameterLayout& 
 
 /// Integral (energy) model over a sampled interval (seed 1 eqs. 8–18):
 /// y = ∫ tauᵀ dq dt = d · theta, with d = h(t_end) − h(t_begin) plus the friction-work columns
-/// ∫ dq_j² dt (Fv), ∫ |dq_j| dt (Fc), ∫ dq_j dt (Fo) by the trapezoidal rule; asymmetric columns
-/// split those integrals by the sign of dq_j. t: size m ≥ 2, strictly increasing [s]; q, dq: m × n
+/// ∫ dq_j² dt (Fv), ∫ |dq_j| dt (Fc), ∫ dq_j dt (Fo), each step by step_velocity_integrals (exact
+/// for q cubic over the step); asymmetric columns split those integrals by the sign of dq_j. y by
+/// the trapezoidal rule. t: size m ≥ 2, strictly increasing [s]; q, dq: m × n
 /// (one sample per row). Returns y through `y` and the row through `d`.
 void integral_regressor(const Model& model, Workspace& ws, const ParameterLayout& layout,
                         const Eigen::Ref<const Eigen::VectorXd>& t,
