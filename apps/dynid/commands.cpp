@@ -13,6 +13,7 @@ void add_commands(CLI::App& app) {
   add_excite_command(app);
   add_simulate_command(app);
   add_demo_command(app);
+  add_payload_command(app);
   check_numeric_flags(app);
 }
 

@@ -33,4 +33,7 @@ void add_excite_command(CLI::App& app);
 /// `dynid simulate`: closed-loop run of a reference on a simulated robot (cmd_simulate.cpp).
 void add_simulate_command(CLI::App& app);
 
+/// `dynid payload`: a gripped load's parameters from a wrist force/torque sensor (cmd_payload.cpp).
+void add_payload_command(CLI::App& app);
+
 }  // namespace dynid::cli

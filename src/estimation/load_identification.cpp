@@ -31,6 +31,14 @@ void check_rows(const Eigen::MatrixXd& x, Eigen::Index m, Eigen::Index cols, con
   }
 }
 
+void check_gravity(const Eigen::Vector3d& gravity) {
+  if (!gravity.allFinite() || !(gravity.norm() > 0.0)) {
+    throw Error(
+        "the gravity vector is zero or not finite; the load's mass is seen only through "
+        "gravity: give the base-frame gravity, e.g. 0 0 -9.81 m/s^2");
+  }
+}
+
 }  // namespace
 
 int find_link(const Model& model, const std::string& name) {
@@ -57,6 +65,7 @@ SensorMotion sensor_motion_from_joints(const Model& model, const JointRecord& re
     throw Error("sensor link index " + std::to_string(mount.link) + " is outside 0.." +
                 std::to_string(n - 1));
   }
+  check_gravity(model.gravity);
   const Eigen::Index m = record.q.rows();
   check_rows(record.q, m, n, "q");
   const bool standing = record.dq.size() == 0 && record.ddq.size() == 0;
@@ -96,6 +105,7 @@ SensorMotion sensor_motion_from_joints(const Model& model, const JointRecord& re
 SensorMotion sensor_motion_from_orientation(
     const OrientationLog& log, const Eigen::Vector3d& gravity,
     std::vector<std::pair<std::string, std::string>>& choices) {
+  check_gravity(gravity);
   const Eigen::Index m = log.quaternion.rows();
   check_rows(log.quaternion, m, 4, "the quaternion qx qy qz qw");
   if (log.w.size()) check_rows(log.w, m, 3, "the angular velocity wx wy wz");
@@ -163,6 +173,42 @@ SensorMotion sensor_motion_from_orientation(
   return out;
 }
 
+PreparedLoadRun prepare_load_run(const JointRecord& record,
+                                 const Eigen::Ref<const Eigen::MatrixXd>& wrench,
+                                 const SignalOptions& options,
+                                 std::vector<std::pair<std::string, std::string>>& choices) {
+  if (wrench.rows() != record.q.rows() || wrench.cols() != 6) {
+    throw Error("the wrench has " + std::to_string(wrench.rows()) + " rows of " +
+                std::to_string(wrench.cols()) + " values where " + std::to_string(record.q.rows()) +
+                " rows of fx fy fz mx my mz are needed");
+  }
+  JointRecord joints = record;
+  joints.tau = Eigen::MatrixXd::Zero(record.q.rows(), record.q.cols());
+  ProcessedRecord processed = preprocess(joints, options, choices);
+  // The wrench through preprocess() as positions with the first run's resolved cut-off, trim and
+  // decimation: the same filter, edges and rows, without a second copy of the processing.
+  SignalOptions same = options;
+  same.cutoff_hz = processed.cutoff_hz;
+  for (const auto& [key, value] : choices) {
+    if (key == "trim") same.trim = std::stoi(value);
+    if (key == "decimate") same.decimate = std::stoi(value);
+  }
+  JointRecord force;
+  force.t = record.t;
+  force.q = wrench;
+  force.tau = Eigen::MatrixXd::Zero(wrench.rows(), 6);
+  std::vector<std::pair<std::string, std::string>> ignored;
+  PreparedLoadRun out;
+  out.wrench = preprocess(force, same, ignored).record.q;
+  out.record = std::move(processed.record);
+  // The load equations have no Coulomb columns: that choice of preprocess() does not apply.
+  choices.erase(std::remove_if(choices.begin(), choices.end(),
+                               [](const auto& c) { return c.first == "coulomb_columns"; }),
+                choices.end());
+  choices.emplace_back("wrench", "filtered, trimmed and decimated like q");
+  return out;
+}
+
 std::vector<std::string> load_parameter_names(const LoadEquationOptions& options) {
   std::vector<std::string> names = {"m", "mcx", "mcy", "mcz"};
   if (options.model != LoadModelKind::kStatic) {
@@ -225,6 +271,12 @@ EquationBlock load_equations(const SensorMotion& motion,
     block.t.resize(6 * equations);
   };
   const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  if (standing && m < (options.bias ? 3 : 2)) {
+    throw Error("the static model needs at least " + std::to_string(options.bias ? 3 : 2) +
+                " standing poses with different sensor orientations" +
+                (options.bias ? " (3 with the six offsets)" : "") + "; the data have " +
+                std::to_string(m));
+  }
   if (options.model != LoadModelKind::kIntegral) {
     resize(m);
     for (Eigen::Index k = 0; k < m; ++k) {
@@ -336,14 +388,15 @@ LoadIdentificationResult identify_load(const EquationBlock& block,
                                            options.record_history ? &out.history : nullptr);
   }
   const Estimate& e = out.estimate;
-  if (!e.unidentifiable.empty() &&
-      std::find(e.unidentifiable.begin(), e.unidentifiable.end(), 0) != e.unidentifiable.end()) {
+  if (std::any_of(e.unidentifiable.begin(), e.unidentifiable.end(),
+                  [](Eigen::Index j) { return j < 4; })) {
     std::string names;
-    for (const Eigen::Index j : e.unidentifiable)
-      names += (names.empty() ? "" : ", ") + out.names[j];
-    throw Error("the data do not determine the mass (with " + names +
-                "): gravity keeps one direction in the sensor frame; record poses or a motion "
-                "with several sensor orientations");
+    for (const Eigen::Index j : e.unidentifiable) {
+      names += (names.empty() ? "" : ", ") + out.names[static_cast<std::size_t>(j)];
+    }
+    throw Error("the data do not determine " + names +
+                ": gravity keeps one direction in the sensor frame (the poses are all the same); "
+                "record poses or a motion with several sensor orientations");
   }
   if (e.ci_upper(0) < 0.0) {
     throw Error("the identified mass is negative (" + std::to_string(e.x(0)) + " kg, interval " +

@@ -12,123 +12,15 @@
 #include "dynid/dynamics/rnea.hpp"
 #include "dynid/estimation/load_identification.hpp"
 #include "estimation/estimation_support.hpp"
+#include "support/load_rig.hpp"
 #include "support/random_models.hpp"
 
 namespace dynid {
 namespace {
 
+using namespace load_rig;
+
 using estimation_testing::expect_error;
-
-constexpr int kJoints = 6;
-
-// The truth: seed 1 Table I's mass and first moments (1.910 kg steel cuboid) with the inertia of
-// a 50×50×97 mm steel cuboid about its centre of mass. Table I's own computed inertias are not
-// physically consistent (principal moments about the centre of mass 4.0e-5, 3.27e-3, 4.49e-3
-// kg m²: the triangle inequality fails), so they cannot be a rigid body's.
-Eigen::VectorXd table_one_load() {
-  const double m = 1.910;
-  const Eigen::Vector3d c = Eigen::Vector3d(0.0573, -0.0210, 0.1394) / m;
-  const double a = 0.05, b = 0.05, h = 0.097;
-  const Eigen::Vector3d d(m * (b * b + h * h) / 12.0, m * (a * a + h * h) / 12.0,
-                          m * (a * a + b * b) / 12.0);
-  const Eigen::Matrix3d R = roll_pitch_yaw(0.2, 0.1, -0.3);
-  const LinkParams p = link_params_from_com(m, c, R * d.asDiagonal() * R.transpose());
-  Eigen::VectorXd phi(10);
-  phi << p(9), p(6), p(7), p(8), p(0), p(1), p(2), p(3), p(4), p(5);
-  return phi;
-}
-
-LinkParams to_link_order(const Eigen::VectorXd& phi) {
-  LinkParams p;
-  p << phi(4), phi(5), phi(6), phi(7), phi(8), phi(9), phi(1), phi(2), phi(3), phi(0);
-  return p;
-}
-
-// A 6-joint chain with the sensor at `mount` on its last link, and the same chain with the load as
-// a seventh link whose joint frame is the sensor frame (held still): RNEA's force and moment on
-// that link are the wrench the sensor exerts on the load (seed 1's F, N), independently of K.
-struct Rig {
-  Model robot;
-  Model loaded;
-  SensorMount mount;
-};
-
-Rig make_rig(const Eigen::VectorXd& phi, unsigned seed) {
-  Rig rig;
-  rig.robot = testing::random_tree(kJoints, seed, false, true);
-  rig.mount.link = kJoints - 1;
-  rig.mount.R_LS = roll_pitch_yaw(0.3, -0.2, 0.5);
-  rig.mount.p_LS = Eigen::Vector3d(0.02, -0.01, 0.08);
-  rig.loaded = rig.robot;
-  Joint holder;
-  holder.name = "sensor";
-  holder.link_name = "load";
-  holder.parent = kJoints - 1;
-  holder.R_PJ = rig.mount.R_LS;
-  holder.p_PJ = rig.mount.p_LS;
-  rig.loaded.joints.push_back(holder);
-  rig.loaded.links.push_back(to_link_order(phi));
-  rig.loaded.transmission = Transmission{};
-  rig.loaded.finalize();
-  return rig;
-}
-
-// Joint motion: a sum of two sines per joint with exact derivatives.
-void trajectory(double t, Eigen::VectorXd& q, Eigen::VectorXd& dq, Eigen::VectorXd& ddq) {
-  q.resize(kJoints);
-  dq.resize(kJoints);
-  ddq.resize(kJoints);
-  for (int j = 0; j < kJoints; ++j) {
-    const double a1 = 0.6 + 0.1 * j, w1 = 1.1 + 0.37 * j, a2 = 0.3, w2 = 2.3 + 0.21 * j;
-    q(j) = a1 * std::sin(w1 * t + j) + a2 * std::sin(w2 * t);
-    dq(j) = a1 * w1 * std::cos(w1 * t + j) + a2 * w2 * std::cos(w2 * t);
-    ddq(j) = -a1 * w1 * w1 * std::sin(w1 * t + j) - a2 * w2 * w2 * std::sin(w2 * t);
-  }
-}
-
-struct LoadRun {
-  JointRecord record;
-  Eigen::MatrixXd reading;  // m×6: what the sensor reports (force of the load on the sensor)
-};
-
-LoadRun simulate(const Rig& rig, double duration, double rate) {
-  const auto m = static_cast<Eigen::Index>(std::lround(duration * rate)) + 1;
-  LoadRun run;
-  run.record.t.resize(m);
-  run.record.q.resize(m, kJoints);
-  run.record.dq.resize(m, kJoints);
-  run.record.ddq.resize(m, kJoints);
-  run.reading.resize(m, 6);
-  Workspace ws(rig.loaded);
-  Eigen::VectorXd q, dq, ddq, tau(kJoints + 1);
-  RneaOptions options;
-  options.joint_terms = false;
-  for (Eigen::Index k = 0; k < m; ++k) {
-    const double t = static_cast<double>(k) / rate;
-    trajectory(t, q, dq, ddq);
-    run.record.t(k) = t;
-    run.record.q.row(k) = q.transpose();
-    run.record.dq.row(k) = dq.transpose();
-    run.record.ddq.row(k) = ddq.transpose();
-    Eigen::VectorXd q7 = Eigen::VectorXd::Zero(kJoints + 1), dq7 = q7, ddq7 = q7;
-    q7.head(kJoints) = q;
-    dq7.head(kJoints) = dq;
-    ddq7.head(kJoints) = ddq;
-    rnea(rig.loaded, ws, q7, dq7, ddq7, tau, options);
-    run.reading.row(k).head<3>() = -ws.links[kJoints].f.transpose();
-    run.reading.row(k).tail<3>() = -ws.links[kJoints].n.transpose();
-  }
-  return run;
-}
-
-void add_noise(Eigen::MatrixXd& reading, unsigned seed, double force_std, double moment_std) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> f(0.0, force_std), n(0.0, moment_std);
-  for (Eigen::Index k = 0; k < reading.rows(); ++k) {
-    for (int c = 0; c < 3; ++c) reading(k, c) += f(rng);
-    for (int c = 3; c < 6; ++c) reading(k, c) += n(rng);
-  }
-}
 
 // The sensor frame's pose in the base frame, from forward kinematics alone.
 void sensor_pose(const Rig& rig, const Eigen::VectorXd& q, Eigen::Matrix3d& R, Eigen::Vector3d& p) {
@@ -140,7 +32,7 @@ void sensor_pose(const Rig& rig, const Eigen::VectorXd& q, Eigen::Matrix3d& R, E
 }
 
 TEST(LoadKinematics, SensorMotionMatchesFiniteDifferencesOfThePose) {
-  const Rig rig = make_rig(table_one_load(), 3);
+  const Rig rig = random_rig(table_one_load(), 3);
   const double h = 1e-4;
   for (const double t : {0.1, 0.77, 1.9}) {
     JointRecord record;
@@ -186,7 +78,7 @@ TEST(LoadKinematics, SensorMotionMatchesFiniteDifferencesOfThePose) {
 }
 
 TEST(LoadKinematics, QuaternionLogGivesTheJointKinematicsMotion) {
-  const Rig rig = make_rig(table_one_load(), 4);
+  const Rig rig = random_rig(table_one_load(), 4);
   const LoadRun run = simulate(rig, 1.0, 2000.0);
   const SensorMotion ref = sensor_motion_from_joints(rig.robot, run.record, rig.mount);
   OrientationLog log;
@@ -234,7 +126,7 @@ LoadIdentificationResult identify(const Rig& rig, const LoadRun& run,
 
 TEST(LoadIdentification, DifferentialModelRecoversTheLoadWithoutNoise) {
   const Eigen::VectorXd phi = table_one_load();
-  const Rig rig = make_rig(phi, 5);
+  const Rig rig = random_rig(phi, 5);
   const LoadRun run = simulate(rig, 2.0, 200.0);
   const LoadIdentificationResult r = identify(rig, run, {});
   ASSERT_EQ(r.estimate.x.size(), 10);
@@ -246,7 +138,7 @@ TEST(LoadIdentification, DifferentialModelRecoversTheLoadWithoutNoise) {
 
 TEST(LoadIdentification, SeedOneSignConventionIsTheNegativeReading) {
   const Eigen::VectorXd phi = table_one_load();
-  const Rig rig = make_rig(phi, 6);
+  const Rig rig = random_rig(phi, 6);
   LoadRun run = simulate(rig, 2.0, 200.0);
   run.reading *= -1.0;  // logged as the force on the load (seed 1's F, N)
   LoadEquationOptions options;
@@ -257,7 +149,7 @@ TEST(LoadIdentification, SeedOneSignConventionIsTheNegativeReading) {
 
 TEST(LoadIdentification, IntegralModelRecoversTheLoadWithoutAccelerations) {
   const Eigen::VectorXd phi = table_one_load();
-  const Rig rig = make_rig(phi, 7);
+  const Rig rig = random_rig(phi, 7);
   LoadRun run = simulate(rig, 3.0, 1000.0);
   SensorMotion motion = sensor_motion_from_joints(rig.robot, run.record, rig.mount);
   motion.dw.setConstant(std::nan(""));  // eqs. 29–31 must not read accelerations
@@ -274,7 +166,7 @@ TEST(LoadIdentification, IntegralModelRecoversTheLoadWithoutAccelerations) {
 
 TEST(LoadIdentification, BiasesAreRecoveredWithTheLoad) {
   const Eigen::VectorXd phi = table_one_load();
-  const Rig rig = make_rig(phi, 8);
+  const Rig rig = random_rig(phi, 8);
   LoadRun run = simulate(rig, 2.0, 1000.0);
   Eigen::Matrix<double, 1, 6> bias;
   bias << 1.5, -0.7, 3.2, 0.05, -0.12, 0.02;
@@ -298,7 +190,7 @@ TEST(LoadIdentification, NoisyWrenchCoverageAtFixedSeeds) {
   const Eigen::VectorXd phi = table_one_load();
   int outside = 0, total = 0;
   for (unsigned seed = 0; seed < 10; ++seed) {
-    const Rig rig = make_rig(phi, 20 + seed);
+    const Rig rig = random_rig(phi, 20 + seed);
     LoadRun run = simulate(rig, 2.0, 250.0);
     add_noise(run.reading, 100 + seed, 0.05, 0.003);
     for (const LoadModelKind model : {LoadModelKind::kDifferential, LoadModelKind::kIntegral}) {
@@ -319,7 +211,7 @@ TEST(LoadIdentification, NoisyWrenchCoverageAtFixedSeeds) {
 
 TEST(LoadIdentification, RecursiveLeastSquaresAgreesWithBatch) {
   const Eigen::VectorXd phi = table_one_load();
-  const Rig rig = make_rig(phi, 9);
+  const Rig rig = random_rig(phi, 9);
   LoadRun run = simulate(rig, 2.0, 200.0);
   add_noise(run.reading, 9, 0.05, 0.003);
   const SensorMotion motion = sensor_motion_from_joints(rig.robot, run.record, rig.mount);
@@ -401,7 +293,7 @@ TEST(LoadIdentification, IdenticalStandingPosesAreAnError) {
 
 TEST(LoadIdentification, SlowMotionLeavesTheInertiasNotExcited) {
   const Eigen::VectorXd phi = table_one_load();
-  Rig rig = make_rig(phi, 13);
+  Rig rig = random_rig(phi, 13);
   LoadRun run = simulate(rig, 2.0, 200.0);
   // The same path twenty times slower: gravity dominates, inertial forces vanish in the noise.
   run.record.t *= 20.0;
@@ -450,7 +342,7 @@ TEST(LoadIdentification, PhysicalConsistencyNamesTheViolatedCondition) {
 }
 
 TEST(LoadIdentification, BadInputErrors) {
-  const Rig rig = make_rig(table_one_load(), 14);
+  const Rig rig = random_rig(table_one_load(), 14);
   LoadRun run = simulate(rig, 1.0, 100.0);
   const SensorMotion motion = sensor_motion_from_joints(rig.robot, run.record, rig.mount);
   expect_error([&] { load_equations(motion, run.reading.leftCols(5), {}); }, {"fx fy fz mx my mz"});

@@ -44,9 +44,24 @@ Eigen::Matrix3d roll_pitch_yaw(double roll, double pitch, double yaw);
 /// p̈_S = R_LSᵀ(a_L + ω̇_L×p_LS + ω_L×(ω_L×p_LS)), v_S = R_LSᵀ(v_L + ω_L×p_LS),
 /// g_S = (R_WL·R_LS)ᵀ·model.gravity (seed 1 eq. 28's p̈, ω, ω̇ and ⁰_P R g). record: t (m, may be
 /// empty for standing poses), q, dq, ddq (m×n each; dq and ddq may be empty = standing poses).
-/// Throws dynid::Error for size mismatches or a link index out of range.
+/// Throws dynid::Error for size mismatches, a link index out of range, or a zero gravity.
 SensorMotion sensor_motion_from_joints(const Model& model, const JointRecord& record,
                                        const SensorMount& mount);
+
+/// A joint-side run with its wrench, prepared for the load equations.
+struct PreparedLoadRun {
+  JointRecord record;      ///< filtered, differentiated, trimmed, decimated (tau unused, zero)
+  Eigen::MatrixXd wrench;  ///< m×6, the same zero-phase filter, trim and decimation as q
+};
+
+/// preprocess() (identify's signal processing) on t, q [, dq, ddq] of `record`, and the same
+/// filter, trim and decimation on the wrench (m×6), so that kinematics and wrench keep one delay
+/// and bandwidth (Gautier's parallel filtering, as for q and tau). Choices go to `choices`.
+/// Throws dynid::Error as preprocess(), or for a wrench whose row count differs from q's.
+PreparedLoadRun prepare_load_run(const JointRecord& record,
+                                 const Eigen::Ref<const Eigen::MatrixXd>& wrench,
+                                 const SignalOptions& options,
+                                 std::vector<std::pair<std::string, std::string>>& choices);
 
 /// The sensor's own log: orientation and optional rates (columns qx qy qz qw wx wy wz dwx dwy dwz
 /// ax ay az of `dynid payload`).
@@ -62,7 +77,8 @@ struct OrientationLog {
 /// quaternion's central difference, ω_S = 2·vec(q̄ ⊗ q̇) (sign flips between rows removed first);
 /// a missing ω̇ from ω by central differences; a missing p̈ is taken as zero (a sensor that only
 /// turns about its origin) and said so in `choices`. Standing poses (empty t) have ω = ω̇ = p̈ = 0.
-/// Throws dynid::Error: a quaternion whose norm is not 1 within 1e-3 (names the row), sizes.
+/// Throws dynid::Error: a quaternion whose norm is not 1 within 1e-3 (names the row), sizes, a
+/// zero or non-finite gravity.
 SensorMotion sensor_motion_from_orientation(
     const OrientationLog& log, const Eigen::Vector3d& gravity,
     std::vector<std::pair<std::string, std::string>>& choices);
@@ -97,7 +113,8 @@ std::vector<std::string> load_parameter_names(const LoadEquationOptions& options
 /// a window). One row per wrench component and sample/window; group = component (fx fy fz mx my
 /// mz), sample = sample/window index, t = its time (window end). wrench: m×6 [N, N·m], sensor
 /// frame. Throws dynid::Error: size mismatch, NaN/Inf, missing t or ω̇/p̈ where the model needs
-/// them, an interval shorter than one sample step or giving fewer windows than parameters need.
+/// them, an interval shorter than one sample step or giving fewer windows than parameters need,
+/// fewer standing poses than the static model needs (2, or 3 with biases).
 EquationBlock load_equations(const SensorMotion& motion,
                              const Eigen::Ref<const Eigen::MatrixXd>& wrench,
                              const LoadEquationOptions& options);
@@ -143,6 +160,7 @@ struct LoadIdentificationResult {
 
 /// Estimates the load parameters from a block built by load_equations (OLS or U-D RLS), with the
 /// physical reading and the not-excited list. Throws dynid::Error: fewer rows than columns, NaN;
+/// m or a first moment unidentifiable (gravity never changed direction in the sensor frame);
 /// a mass whose interval contains 0 (no load on the sensor) or that is significantly negative
 /// (the wrench logged with the other sign: names --wrench-sign).
 LoadIdentificationResult identify_load(const EquationBlock& block,
