@@ -182,6 +182,8 @@ void run_payload(const PayloadCliOptions& cli) {
       signal.filter = !cli.no_filter;
       signal.cutoff_hz = cli.cutoff;
       PreparedLoadRun run = prepare_load_run(record, wrench, signal, choices);
+      // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
+      options.hac_covariance = signal.filter;
       wrench = std::move(run.wrench);
       motion = sensor_motion_from_joints(model, run.record, mount);
     }
@@ -219,6 +221,7 @@ void run_payload(const PayloadCliOptions& cli) {
       {"frame", frame},
       {"wrench_sign", cli.wrench_sign},
       {"confidence_level", e.confidence_level},
+      {"covariance", e.covariance_kind},
       {"parameters", parameter_json(r)},
       {"mass", json_number(r.physics.mass)},
       {"com", r.physics.mass > 0.0

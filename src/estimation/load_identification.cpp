@@ -11,6 +11,7 @@
 #include "dynid/dynamics/kinematics.hpp"
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/recursive_least_squares.hpp"
+#include "dynid/estimation/statistics.hpp"
 #include "dynid/regressor/load_regressor.hpp"
 #include "dynid/signal/differentiation.hpp"
 
@@ -386,6 +387,21 @@ LoadIdentificationResult identify_load(const EquationBlock& block,
     rls.record_history = options.record_history;
     out.estimate = recursive_least_squares(block.W, block.y, rls, estimation,
                                            options.record_history ? &out.history : nullptr);
+  }
+  if (options.hac_covariance) {
+    // The sandwich needs the rows the estimator solved: WLS divides group g's rows by σ_g.
+    Eigen::MatrixXd W = block.W;
+    Eigen::VectorXd y = block.y;
+    if (options.estimator == LoadEstimator::kWls) {
+      for (Eigen::Index i = 0; i < W.rows(); ++i) {
+        const double v = out.estimate.group_variance(block.group(i));
+        const double s = v > 0.0 && std::isfinite(v) ? 1.0 / std::sqrt(v) : 1.0;
+        W.row(i) *= s;
+        y(i) *= s;
+      }
+    }
+    const Eigen::VectorXd residual = y - W * out.estimate.x;
+    apply_hac_covariance(out.estimate, W, residual, block.sample, estimation);
   }
   const Estimate& e = out.estimate;
   if (std::any_of(e.unidentifiable.begin(), e.unidentifiable.end(),

@@ -209,6 +209,40 @@ TEST(LoadIdentification, NoisyWrenchCoverageAtFixedSeeds) {
   EXPECT_LE(outside, 1) << outside << " of " << total;
 }
 
+// The CLI's joint-data path: q only, identify's filtering and differentiation, the wrench filtered
+// alike, HAC intervals (the filter correlates neighbouring residuals).
+TEST(LoadIdentification, FilteredJointDataCoverageAtFixedSeeds) {
+  const Eigen::VectorXd phi = table_one_load();
+  int outside = 0, outside_white = 0, total = 0;
+  for (unsigned seed = 0; seed < 6; ++seed) {
+    const Rig rig = random_rig(phi, 40 + seed);
+    LoadRun run = simulate(rig, 3.0, 500.0);
+    add_noise(run.reading, 200 + seed, 0.05, 0.003);
+    JointRecord record;
+    record.t = run.record.t;
+    record.q = run.record.q;
+    std::vector<std::pair<std::string, std::string>> choices;
+    const PreparedLoadRun prepared = prepare_load_run(record, run.reading, {}, choices);
+    ASSERT_EQ(prepared.wrench.rows(), prepared.record.t.size());
+    ASSERT_LT(prepared.record.t.size(), record.t.size());  // filter edges trimmed
+    const SensorMotion motion = sensor_motion_from_joints(rig.robot, prepared.record, rig.mount);
+    LoadIdentificationOptions options;
+    options.estimator = LoadEstimator::kWls;
+    options.hac_covariance = true;
+    const LoadIdentificationResult r =
+        identify_load(load_equations(motion, prepared.wrench, {}), options);
+    EXPECT_NE(r.estimate.covariance_kind, "white");
+    for (int j = 0; j < 10; ++j) {
+      ++total;
+      outside += phi(j) < r.estimate.ci_lower(j) || phi(j) > r.estimate.ci_upper(j);
+      outside_white +=
+          phi(j) < r.estimate.ci_lower_white(j) || phi(j) > r.estimate.ci_upper_white(j);
+    }
+  }
+  // 60 intervals at 99.9 %: 0.06 expected outside.
+  EXPECT_LE(outside, 1) << outside << " of " << total << " (white: " << outside_white << ")";
+}
+
 TEST(LoadIdentification, RecursiveLeastSquaresAgreesWithBatch) {
   const Eigen::VectorXd phi = table_one_load();
   const Rig rig = random_rig(phi, 9);

@@ -131,6 +131,10 @@ struct LoadIdentificationOptions {
   LoadEstimator estimator = LoadEstimator::kOls;  ///< batch or recursive
   double confidence_level = 0.999;                ///< Student-t interval level
   bool record_history = false;                    ///< RLS: keep the estimate after every row
+  /// Replace the white covariance by the Newey–West sandwich over samples
+  /// (apply_hac_covariance): needed when the wrench was low-pass filtered, which correlates the
+  /// residuals of neighbouring samples and makes white intervals too narrow.
+  bool hac_covariance = false;
 };
 
 /// Physical reading of the ten load parameters about the sensor origin.
