@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <Eigen/Eigenvalues>
@@ -371,22 +372,24 @@ LoadPhysics load_physics(const Eigen::Ref<const Eigen::VectorXd>& phi, bool with
   return out;
 }
 
-LoadIdentificationResult identify_load(const EquationBlock& block,
-                                       const LoadIdentificationOptions& options) {
-  LoadIdentificationResult out;
-  out.names = block.columns;
+namespace {
+
+// The block's estimate by the estimator of `options`, with the HAC sandwich when asked.
+Estimate estimate_block(const EquationBlock& block, const LoadIdentificationOptions& options,
+                        Eigen::MatrixXd* history) {
   EstimationOptions estimation;
   estimation.confidence_level = options.confidence_level;
   estimation.names = block.columns;
+  Estimate estimate;
   if (options.estimator == LoadEstimator::kOls) {
-    out.estimate = ordinary_least_squares(block.W, block.y, block.group, estimation);
+    estimate = ordinary_least_squares(block.W, block.y, block.group, estimation);
   } else if (options.estimator == LoadEstimator::kWls) {
-    out.estimate = weighted_least_squares(block.W, block.y, block.group, estimation);
+    estimate = weighted_least_squares(block.W, block.y, block.group, estimation);
   } else {
     RecursiveLeastSquaresOptions rls;
     rls.record_history = options.record_history;
-    out.estimate = recursive_least_squares(block.W, block.y, rls, estimation,
-                                           options.record_history ? &out.history : nullptr);
+    estimate = recursive_least_squares(block.W, block.y, rls, estimation,
+                                       options.record_history ? history : nullptr);
   }
   if (options.hac_covariance) {
     // The sandwich needs the rows the estimator solved: WLS divides group g's rows by σ_g.
@@ -394,15 +397,65 @@ LoadIdentificationResult identify_load(const EquationBlock& block,
     Eigen::VectorXd y = block.y;
     if (options.estimator == LoadEstimator::kWls) {
       for (Eigen::Index i = 0; i < W.rows(); ++i) {
-        const double v = out.estimate.group_variance(block.group(i));
+        const double v = estimate.group_variance(block.group(i));
         const double s = v > 0.0 && std::isfinite(v) ? 1.0 / std::sqrt(v) : 1.0;
         W.row(i) *= s;
         y(i) *= s;
       }
     }
-    const Eigen::VectorXd residual = y - W * out.estimate.x;
-    apply_hac_covariance(out.estimate, W, residual, block.sample, estimation);
+    const Eigen::VectorXd residual = y - W * estimate.x;
+    apply_hac_covariance(estimate, W, residual, block.sample, estimation);
   }
+  return estimate;
+}
+
+// The mass checks of identify_load: no load, or the wrench logged with the other sign.
+void check_mass(const Estimate& e) {
+  if (e.ci_upper(0) < 0.0) {
+    throw Error("the identified mass is negative (" + std::to_string(e.x(0)) + " kg, interval " +
+                std::to_string(e.ci_lower(0)) + ".." + std::to_string(e.ci_upper(0)) +
+                "): the wrench was logged as the force on the load, not on the sensor; give "
+                "--wrench-sign -1");
+  }
+  if (!(e.ci_lower(0) > 0.0)) {
+    throw Error("the data show no load: the mass " + std::to_string(e.x(0)) +
+                " kg is not distinguishable from zero (interval " + std::to_string(e.ci_lower(0)) +
+                ".." + std::to_string(e.ci_upper(0)) +
+                "); check that a load was gripped and that the data columns are the right ones");
+  }
+}
+
+// Rows of `e` restricted to parameters first..first+count-1 (x, σ, intervals, covariance).
+Estimate slice(const Estimate& e, Eigen::Index first, Eigen::Index count) {
+  Estimate out = e;
+  out.x = e.x.segment(first, count);
+  out.covariance = e.covariance.block(first, first, count, count);
+  out.std_dev = e.std_dev.segment(first, count);
+  out.relative_std_percent = e.relative_std_percent.segment(first, count);
+  out.ci_lower = e.ci_lower.segment(first, count);
+  out.ci_upper = e.ci_upper.segment(first, count);
+  for (Eigen::VectorXd* v : {&out.std_dev_white, &out.ci_lower_white, &out.ci_upper_white}) {
+    if (v->size()) *v = v->segment(first, count).eval();
+  }
+  out.unidentifiable.clear();
+  for (const Eigen::Index j : e.unidentifiable) {
+    if (j >= first && j < first + count) out.unidentifiable.push_back(j - first);
+  }
+  out.poorly_excited.clear();
+  for (const Eigen::Index j : e.poorly_excited) {
+    if (j >= first && j < first + count) out.poorly_excited.push_back(j - first);
+  }
+  out.dependent_columns.clear();
+  return out;
+}
+
+}  // namespace
+
+LoadIdentificationResult identify_load(const EquationBlock& block,
+                                       const LoadIdentificationOptions& options) {
+  LoadIdentificationResult out;
+  out.names = block.columns;
+  out.estimate = estimate_block(block, options, &out.history);
   const Estimate& e = out.estimate;
   if (std::any_of(e.unidentifiable.begin(), e.unidentifiable.end(),
                   [](Eigen::Index j) { return j < 4; })) {
@@ -414,18 +467,7 @@ LoadIdentificationResult identify_load(const EquationBlock& block,
                 ": gravity keeps one direction in the sensor frame (the poses are all the same); "
                 "record poses or a motion with several sensor orientations");
   }
-  if (e.ci_upper(0) < 0.0) {
-    throw Error("the identified mass is negative (" + std::to_string(e.x(0)) + " kg, interval " +
-                std::to_string(e.ci_lower(0)) + ".." + std::to_string(e.ci_upper(0)) +
-                "): the wrench was logged as the force on the load, not on the sensor; give "
-                "--wrench-sign -1");
-  }
-  if (!(e.ci_lower(0) > 0.0)) {
-    throw Error("the wrench shows no load: the mass " + std::to_string(e.x(0)) +
-                " kg is not distinguishable from zero (interval " + std::to_string(e.ci_lower(0)) +
-                ".." + std::to_string(e.ci_upper(0)) +
-                "); check that a load was gripped and that fx..mz are the sensor's columns");
-  }
+  check_mass(e);
   std::vector<bool> flagged(out.names.size(), false);
   for (const Eigen::Index j : e.unidentifiable) flagged[j] = true;
   const auto first_inertia = std::find(out.names.begin(), out.names.end(), "Ixx");
@@ -450,6 +492,74 @@ LoadIdentificationResult identify_load(const EquationBlock& block,
   }
   const bool with_inertia = std::find(out.names.begin(), out.names.end(), "Ixx") != out.names.end();
   out.physics = load_physics(e.x, with_inertia);
+  return out;
+}
+
+LoadIdentificationResult identify_load_from_torques(const Model& model, int link,
+                                                    const LoadFrame& frame,
+                                                    const ParameterLayout& layout,
+                                                    const JointRecord& loaded,
+                                                    const JointRecord& unloaded,
+                                                    const LoadIdentificationOptions& options) {
+  const int n = model.dof();
+  if (link < 0 || link >= n) {
+    throw Error("load link index " + std::to_string(link) + " is outside 0.." +
+                std::to_string(n - 1));
+  }
+  const Eigen::MatrixXd Y_loaded = stacked_regressor(model, layout, false, loaded);
+  const Eigen::MatrixXd Y_unloaded = stacked_regressor(model, layout, false, unloaded);
+  const Eigen::Index p = Y_loaded.cols(), rows_l = Y_loaded.rows(), rows_u = Y_unloaded.rows();
+  // T: load parameters about F (link order) → about the link origin; column k = T·e_k.
+  Eigen::Matrix<double, kLinkParams, kLinkParams> T;
+  for (int k = 0; k < kLinkParams; ++k) {
+    T.col(k) = transform_link_params(LinkParams::Unit(k), frame.R_LF, frame.p_LF);
+  }
+  // Load order m mcx mcy mcz Ixx … Izz = link order indices M MX MY MZ XX … ZZ.
+  const int kFromLinkOrder[kLinkParams] = {9, 6, 7, 8, 0, 1, 2, 3, 4, 5};
+  const Eigen::MatrixXd load_link = Y_loaded.middleCols(kLinkParams * link, kLinkParams) * T;
+  EquationBlock block;
+  block.W.setZero(rows_l + rows_u, p + kLinkParams);
+  block.W.topLeftCorner(rows_l, p) = Y_loaded;
+  block.W.bottomLeftCorner(rows_u, p) = Y_unloaded;
+  for (int k = 0; k < kLinkParams; ++k) {
+    block.W.block(0, p + k, rows_l, 1) = load_link.col(kFromLinkOrder[k]);
+  }
+  block.y.resize(rows_l + rows_u);
+  for (Eigen::Index k = 0; k < loaded.tau.rows(); ++k) {
+    block.y.segment(k * n, n) = loaded.tau.row(k).transpose();
+  }
+  for (Eigen::Index k = 0; k < unloaded.tau.rows(); ++k) {
+    block.y.segment(rows_l + k * n, n) = unloaded.tau.row(k).transpose();
+  }
+  block.group = joint_row_groups(rows_l + rows_u, n);
+  block.sample.resize(rows_l + rows_u);
+  for (Eigen::Index i = 0; i < rows_l + rows_u; ++i) {
+    block.sample(i) = static_cast<int>(i < rows_l ? i / n : loaded.tau.rows() + (i - rows_l) / n);
+  }
+  block.columns = layout.names(n);
+  for (const auto& name : load_parameter_names({})) block.columns.push_back("load_" + name);
+  LoadIdentificationOptions batch = options;
+  batch.record_history = false;
+  const Estimate full = estimate_block(block, batch, nullptr);
+  LoadIdentificationResult out;
+  out.names = load_parameter_names({});
+  out.estimate = slice(full, p, kLinkParams);
+  std::vector<bool> undetermined(kLinkParams, false);
+  for (const Eigen::Index j : out.estimate.unidentifiable) {
+    undetermined[static_cast<std::size_t>(j)] = true;
+    out.estimate.std_dev(j) = std::numeric_limits<double>::infinity();
+    out.estimate.ci_lower(j) = -std::numeric_limits<double>::infinity();
+    out.estimate.ci_upper(j) = std::numeric_limits<double>::infinity();
+  }
+  for (int k = 0; k < kLinkParams; ++k) {
+    if (undetermined[static_cast<std::size_t>(k)]) out.not_excited.push_back(out.names[k]);
+  }
+  if (!undetermined[0]) check_mass(out.estimate);
+  if (out.not_excited.empty()) {
+    out.physics = load_physics(out.estimate.x, true);
+  } else {
+    out.physics.violated = "not every parameter is determined by the joint torques";
+  }
   return out;
 }
 

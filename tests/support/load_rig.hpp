@@ -94,7 +94,9 @@ struct LoadRun {
   Eigen::MatrixXd reading;  // m×6: what the sensor reports (force of the load on the sensor)
 };
 
-inline LoadRun simulate(const Rig& rig, double duration, double rate) {
+// The run from t0 to t0 + duration; record.tau holds the joint torques of the loaded robot (rigid
+// body only: the loaded model's joint terms are left out).
+inline LoadRun simulate(const Rig& rig, double duration, double rate, double t0 = 0.0) {
   const auto m = static_cast<Eigen::Index>(std::lround(duration * rate)) + 1;
   LoadRun run;
   run.record.t.resize(m);
@@ -102,12 +104,13 @@ inline LoadRun simulate(const Rig& rig, double duration, double rate) {
   run.record.dq.resize(m, kJoints);
   run.record.ddq.resize(m, kJoints);
   run.reading.resize(m, 6);
+  run.record.tau.resize(m, kJoints);
   Workspace ws(rig.loaded);
   Eigen::VectorXd q, dq, ddq, tau(kJoints + 1);
   RneaOptions options;
   options.joint_terms = false;
   for (Eigen::Index k = 0; k < m; ++k) {
-    const double t = static_cast<double>(k) / rate;
+    const double t = t0 + static_cast<double>(k) / rate;
     trajectory(t, q, dq, ddq);
     run.record.t(k) = t;
     run.record.q.row(k) = q.transpose();
@@ -118,6 +121,7 @@ inline LoadRun simulate(const Rig& rig, double duration, double rate) {
     dq7.head(kJoints) = dq;
     ddq7.head(kJoints) = ddq;
     rnea(rig.loaded, ws, q7, dq7, ddq7, tau, options);
+    run.record.tau.row(k) = tau.head(kJoints).transpose();
     run.reading.row(k).head<3>() = -ws.links[kJoints].f.transpose();
     run.reading.row(k).tail<3>() = -ws.links[kJoints].n.transpose();
   }

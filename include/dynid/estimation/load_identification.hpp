@@ -170,4 +170,30 @@ struct LoadIdentificationResult {
 LoadIdentificationResult identify_load(const EquationBlock& block,
                                        const LoadIdentificationOptions& options);
 
+/// Where the load parameters from joint torques are expressed: about the origin of frame F, in
+/// F's axes, F fixed on the link at (R_LF, p_LF) in the link frame (identity: the link frame).
+struct LoadFrame {
+  Eigen::Matrix3d R_LF = Eigen::Matrix3d::Identity();  ///< orientation of F in the link frame
+  Eigen::Vector3d p_LF = Eigen::Vector3d::Zero();      ///< origin of F in the link frame [m]
+};
+
+/// A load on link `link` from joint torques alone (no sensor): the loaded run's torques are
+/// Y(q, q̇, q̈)·[θ; Φ_L] with Φ_L entering like the link's own standard parameters (the load
+/// adds to the link's inertia), the unloaded run's are Y·θ; both runs are stacked and solved
+/// together, [Y_loaded, Y_link·T; Y_unloaded, 0]·[θ; Φ_F] = [τ_loaded; τ_unloaded], where T maps
+/// the load's parameters about F to those about the link origin (transform_link_params, linear).
+/// Φ_F is reported in load order (m mcx … Izz). The joint torques do not determine every load
+/// parameter (a parameter the arm's motion cannot separate from the robot's own, e.g. the mass of
+/// a load on the last link of a 6R wrist): those are listed in not_excited and their σ is +inf;
+/// the physical reading needs all ten. `layout`: the robot's friction/armature columns. Runs:
+/// processed records (preprocess()) with tau. Options as identify_load (WLS groups = joints; HAC
+/// over samples of each run). Throws dynid::Error for a link out of range, sizes, fewer rows than
+/// columns; as identify_load for the mass (when determined).
+LoadIdentificationResult identify_load_from_torques(const Model& model, int link,
+                                                    const LoadFrame& frame,
+                                                    const ParameterLayout& layout,
+                                                    const JointRecord& loaded,
+                                                    const JointRecord& unloaded,
+                                                    const LoadIdentificationOptions& options);
+
 }  // namespace dynid
