@@ -1,5 +1,6 @@
 // `dynid payload`: a gripped load's inertial parameters from a wrist force/torque sensor (seed 1
 // §III). Parse, validate, call the library (estimation/load_identification.hpp), write JSON.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +19,7 @@
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/io/csv_writer.hpp"
 #include "dynid/io/joint_columns.hpp"
+#include "dynid/io/joint_record_file.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/version.hpp"
@@ -27,6 +29,7 @@ namespace {
 
 struct PayloadCliOptions {
   std::string data, robot, sensor_link, sensor_pose, out, history, columns;
+  std::string link, reference, frame;  // joint-torque mode
   std::string model = "differential";
   std::string estimator = "ols";
   std::string gravity = "0 0 -9.81";
@@ -85,6 +88,142 @@ nlohmann::json parameter_json(const LoadIdentificationResult& r) {
   return list;
 }
 
+// The result JSON (docs/cli.md, `dynid payload`), the echo on stderr, the RLS history.
+void write_result(const PayloadCliOptions& cli, const LoadIdentificationResult& r,
+                  const char* model_name, const nlohmann::json& frame, const nlohmann::json& extra,
+                  const std::vector<std::pair<std::string, std::string>>& choices,
+                  const std::vector<std::string>& group_names, bool with_inertia) {
+  const Estimate& e = r.estimate;
+  const bool mass_known =
+      std::find(r.not_excited.begin(), r.not_excited.end(), "m") == r.not_excited.end();
+  nlohmann::json out = {
+      {"command", "payload"},
+      {"model", model_name},
+      {"estimator", to_string(e.summary.estimator)},
+      {"frame", frame},
+      {"confidence_level", e.confidence_level},
+      {"covariance", e.covariance_kind},
+      {"parameters", parameter_json(r)},
+      {"mass", mass_known ? json_number(e.x(0)) : nlohmann::json()},
+      {"com", r.physics.mass > 0.0
+                  ? nlohmann::json{json_number(r.physics.com.x()), json_number(r.physics.com.y()),
+                                   json_number(r.physics.com.z())}
+                  : nlohmann::json()},
+      {"physically_consistent", r.physics.consistent},
+      {"consistency_violation", r.physics.violated},
+      {"not_excited", r.not_excited},
+      {"residual_rms", json_number(e.residual_rms)},
+      {"relative_error", json_number(e.relative_error)},
+      {"condition_number", json_number(e.summary.condition_number)},
+      {"rows", e.summary.rows},
+      {"warnings", e.summary.warnings},
+      {"version", kVersion}};
+  out.update(extra);
+  if (with_inertia && r.physics.mass > 0.0) {
+    const Eigen::Matrix3d& I = r.physics.inertia_com;
+    out["inertia_com"] = {{"Ixx", I(0, 0)}, {"Ixy", I(0, 1)}, {"Ixz", I(0, 2)},
+                          {"Iyy", I(1, 1)}, {"Iyz", I(1, 2)}, {"Izz", I(2, 2)}};
+  } else {
+    out["inertia_com"] = nullptr;
+    if (!with_inertia) {
+      out["not_reported"] =
+          "inertias: standing poses determine only the mass, the first moments "
+          "and the offsets";
+    }
+  }
+  nlohmann::json per_component = nlohmann::json::object();
+  for (std::size_t c = 0; c < group_names.size(); ++c) {
+    per_component[group_names[c]] =
+        json_number(e.group_rms.size() ? e.group_rms(static_cast<Eigen::Index>(c)) : NAN);
+  }
+  out["residual_rms_per_component"] = per_component;
+  nlohmann::json choice_json = nlohmann::json::object();
+  for (const auto& [key, value] : choices) choice_json[key] = value;
+  out["choices"] = choice_json;
+  for (const auto& [key, value] : choices) {
+    std::cerr << "payload: " << key << ": " << one_line(value) << '\n';
+  }
+  for (const auto& w : e.summary.warnings) std::cerr << "warning: " << one_line(w) << '\n';
+  if (!r.physics.consistent) {
+    std::cerr << "warning: the identified load is not physically consistent: "
+              << one_line(r.physics.violated) << '\n';
+  }
+  write_json(cli.out, out);
+  if (!cli.history.empty()) {
+    std::vector<std::string> columns = {"row"};
+    for (const auto& name : r.names) columns.push_back(name);
+    Eigen::MatrixXd history(r.history.rows(), r.history.cols() + 1);
+    history.col(0) =
+        Eigen::VectorXd::LinSpaced(r.history.rows(), 1.0, static_cast<double>(r.history.rows()));
+    history.rightCols(r.history.cols()) = r.history;
+    write_csv(cli.history, columns, history);
+  }
+  std::cout << "payload: m "
+            << (mass_known ? "= " + std::to_string(e.x(0)) + " kg" : "not determined");
+  if (r.physics.mass > 0.0) std::cout << ", c = " << r.physics.com.transpose() << " m";
+  std::cout << (r.physics.consistent ? ", physically consistent" : ", NOT physically consistent")
+            << "; wrote " << cli.out << '\n';
+}
+
+// `--link LINK --reference unloaded.csv`: robot and load together from joint torques.
+void run_payload_from_torques(const PayloadCliOptions& cli, LoadIdentificationOptions options) {
+  if (cli.robot.empty())
+    throw UsageError("--link needs --robot R: the robot that carries the load");
+  if (cli.reference.empty()) {
+    throw UsageError("--link needs --reference: a run of the robot without the load (CSV)");
+  }
+  if (cli.reference.size() >= 5 && cli.reference.substr(cli.reference.size() - 5) == ".json") {
+    throw UsageError("--reference '" + cli.reference +
+                     "': an identify result as reference is not supported yet; give a CSV run "
+                     "of the robot without the load (t, q*, tau*)");
+  }
+  if (cli.standing || !cli.sensor_link.empty() || !cli.sensor_pose.empty() || cli.bias) {
+    throw UsageError(
+        "--link (load from joint torques) does not take --static, --bias, "
+        "--sensor-link or --sensor-pose; use --frame to place the load's frame");
+  }
+  const Model model = load_robot(cli.robot);
+  LoadFrame frame;
+  if (!cli.frame.empty()) {
+    const auto pose = numbers(cli.frame, 6, "--frame",
+                              "\"x y z roll pitch yaw\" [m, rad] of the frame in the link frame");
+    frame.p_LF = Eigen::Vector3d(pose[0], pose[1], pose[2]);
+    frame.R_LF = roll_pitch_yaw(pose[3], pose[4], pose[5]);
+  }
+  const int link = find_link(model, cli.link);
+  RunFileOptions file;
+  file.columns = parse_column_mapping(cli.columns);
+  const JointRecord loaded_raw = read_joint_record(cli.data, model, file);
+  const JointRecord unloaded_raw = read_joint_record(cli.reference, model, file);
+  SignalOptions signal;
+  signal.filter = !cli.no_filter;
+  signal.cutoff_hz = cli.cutoff;
+  std::vector<std::pair<std::string, std::string>> choices, reference_choices;
+  const JointRecord loaded = preprocess(loaded_raw, signal, choices).record;
+  const JointRecord unloaded = preprocess(unloaded_raw, signal, reference_choices).record;
+  // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
+  options.hac_covariance = signal.filter;
+  options.record_history = false;
+  const LoadIdentificationResult r = identify_load_from_torques(
+      model, link, frame, ParameterLayout::full(), loaded, unloaded, options);
+  std::vector<std::string> joints;
+  for (const auto& joint : model.joints) joints.push_back(joint.name);
+  const nlohmann::json where = {{"robot", model.name},
+                                {"link", model.joints[link].link_name},
+                                {"frame", cli.frame.empty() ? "link frame" : cli.frame}};
+  const nlohmann::json extra = {
+      {"reference", cli.reference},
+      {"determined_by_torques", [&] {
+         std::vector<std::string> names;
+         for (const auto& name : r.names) {
+           if (std::find(r.not_excited.begin(), r.not_excited.end(), name) == r.not_excited.end())
+             names.push_back(name);
+         }
+         return names;
+       }()}};
+  write_result(cli, r, "joint_torques", where, extra, choices, joints, true);
+}
+
 void run_payload(const PayloadCliOptions& cli) {
   if (cli.out.empty()) throw UsageError("--out is required: the JSON file to write");
   LoadEquationOptions equations;
@@ -120,6 +259,7 @@ void run_payload(const PayloadCliOptions& cli) {
     throw UsageError("--history needs --estimator rls (the estimate after every wrench sample)");
   }
   options.record_history = !cli.history.empty();
+  if (!cli.link.empty()) return run_payload_from_torques(cli, options);
   if (!cli.robot.empty() && cli.sensor_link.empty()) {
     throw UsageError("--robot needs --sensor-link LINK: the link that carries the sensor");
   }
@@ -209,78 +349,13 @@ void run_payload(const PayloadCliOptions& cli) {
   }
   const EquationBlock block = load_equations(motion, wrench, equations);
   const LoadIdentificationResult r = identify_load(block, options);
-
-  const Estimate& e = r.estimate;
-  const bool with_inertia = equations.model != LoadModelKind::kStatic;
-  nlohmann::json out = {
-      {"command", "payload"},
-      {"model", equations.model == LoadModelKind::kStatic     ? "static"
-                : equations.model == LoadModelKind::kIntegral ? "integral"
-                                                              : "differential"},
-      {"estimator", to_string(e.summary.estimator)},
-      {"frame", frame},
-      {"wrench_sign", cli.wrench_sign},
-      {"confidence_level", e.confidence_level},
-      {"covariance", e.covariance_kind},
-      {"parameters", parameter_json(r)},
-      {"mass", json_number(r.physics.mass)},
-      {"com", r.physics.mass > 0.0
-                  ? nlohmann::json{json_number(r.physics.com.x()), json_number(r.physics.com.y()),
-                                   json_number(r.physics.com.z())}
-                  : nlohmann::json()},
-      {"physically_consistent", r.physics.consistent},
-      {"consistency_violation", r.physics.violated},
-      {"not_excited", r.not_excited},
-      {"residual_rms", json_number(e.residual_rms)},
-      {"relative_error", json_number(e.relative_error)},
-      {"condition_number", json_number(e.summary.condition_number)},
-      {"rows", e.summary.rows},
-      {"warnings", e.summary.warnings},
-      {"version", kVersion}};
-  if (equations.model == LoadModelKind::kIntegral) out["interval"] = cli.interval;
-  if (with_inertia && r.physics.mass > 0.0) {
-    const Eigen::Matrix3d& I = r.physics.inertia_com;
-    out["inertia_com"] = {{"Ixx", I(0, 0)}, {"Ixy", I(0, 1)}, {"Ixz", I(0, 2)},
-                          {"Iyy", I(1, 1)}, {"Iyz", I(1, 2)}, {"Izz", I(2, 2)}};
-  } else {
-    out["inertia_com"] = nullptr;
-    if (!with_inertia) {
-      out["not_reported"] =
-          "inertias: standing poses determine only the mass, the first moments "
-          "and the offsets";
-    }
-  }
-  nlohmann::json per_component = nlohmann::json::object();
-  for (std::size_t c = 0; c < block.group_names.size(); ++c) {
-    per_component[block.group_names[c]] =
-        json_number(e.group_rms.size() ? e.group_rms(static_cast<Eigen::Index>(c)) : NAN);
-  }
-  out["residual_rms_per_component"] = per_component;
-  nlohmann::json choice_json = nlohmann::json::object();
-  for (const auto& [key, value] : choices) choice_json[key] = value;
-  out["choices"] = choice_json;
-  for (const auto& [key, value] : choices) {
-    std::cerr << "payload: " << key << ": " << one_line(value) << '\n';
-  }
-  for (const auto& w : e.summary.warnings) std::cerr << "warning: " << one_line(w) << '\n';
-  if (!r.physics.consistent) {
-    std::cerr << "warning: the identified load is not physically consistent: "
-              << one_line(r.physics.violated) << '\n';
-  }
-  write_json(cli.out, out);
-  if (!cli.history.empty()) {
-    std::vector<std::string> columns = {"row"};
-    for (const auto& name : r.names) columns.push_back(name);
-    Eigen::MatrixXd history(r.history.rows(), r.history.cols() + 1);
-    history.col(0) =
-        Eigen::VectorXd::LinSpaced(r.history.rows(), 1.0, static_cast<double>(r.history.rows()));
-    history.rightCols(r.history.cols()) = r.history;
-    write_csv(cli.history, columns, history);
-  }
-  std::cout << "payload: m = " << r.physics.mass << " kg";
-  if (r.physics.mass > 0.0) std::cout << ", c = " << r.physics.com.transpose() << " m";
-  std::cout << (r.physics.consistent ? ", physically consistent" : ", NOT physically consistent")
-            << "; wrote " << cli.out << '\n';
+  const char* model_name = equations.model == LoadModelKind::kStatic     ? "static"
+                           : equations.model == LoadModelKind::kIntegral ? "integral"
+                                                                         : "differential";
+  nlohmann::json extra = {{"wrench_sign", cli.wrench_sign}};
+  if (equations.model == LoadModelKind::kIntegral) extra["interval"] = cli.interval;
+  write_result(cli, r, model_name, frame, extra, choices, block.group_names,
+               equations.model != LoadModelKind::kStatic);
 }
 
 }  // namespace
@@ -338,6 +413,15 @@ void add_payload_command(CLI::App& app) {
                   "With --robot: low-pass cut-off [Hz] for q and the wrench; 0 = automatic");
   cmd->add_flag("--no-filter", o->no_filter, "With --robot: do not low-pass q and the wrench");
   cmd->add_option("--columns", o->columns, "Rename input columns: from=to,from=to");
+  cmd->add_option("--link", o->link,
+                  "Without a sensor: the link (or joint) that carries the load; --data is then a "
+                  "run with the load (t, q*, tau*) and --reference one without it");
+  cmd->add_option("--reference", o->reference,
+                  "With --link: CSV run of the robot without the load (same or another "
+                  "trajectory); robot and load are identified together");
+  cmd->add_option("--frame", o->frame,
+                  "With --link: \"x y z roll pitch yaw\" of the frame (e.g. the tool flange) in "
+                  "the link frame [m, rad] in which the load is reported; default the link frame");
   cmd->callback([o] { run_payload(*o); });
 }
 

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <random>
 #include <string>
+#include <tuple>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -148,6 +149,38 @@ TEST_F(PayloadCli, RecursiveEstimatorWritesItsHistory) {
   const std::string history = testing::slurp(dir_ / "history.csv");
   EXPECT_EQ(history.rfind("row,m,mcx,mcy,mcz,Ixx", 0), 0u) << history.substr(0, 80);
   EXPECT_NEAR(json("load.json").at("mass").get<double>(), 1.910, 0.02);
+}
+
+// Without a sensor: a loaded and an unloaded run (t, q*, tau*), the load reported at a flange
+// frame.
+TEST_F(PayloadCli, JointTorquesWithAnUnloadedReference) {
+  const Eigen::VectorXd phi = table_one_load();
+  const Rig loaded = puma_rig();
+  const Rig unloaded = make_rig(load_robot("puma560"), Eigen::VectorXd::Zero(10), loaded.mount);
+  std::vector<std::string> columns = {"t"};
+  for (int j = 1; j <= kJoints; ++j) columns.push_back("q" + std::to_string(j));
+  for (int j = 1; j <= kJoints; ++j) columns.push_back("tau" + std::to_string(j));
+  for (const auto& [rig, t0, file, seed] : {std::tuple{&loaded, 0.0, "loaded.csv", 7u},
+                                            std::tuple{&unloaded, 6.0, "unloaded.csv", 8u}}) {
+    LoadRun run = simulate(*rig, 6.0, 200.0, t0);
+    add_noise(run.record.tau, seed, 0.02, 0.02);
+    Eigen::MatrixXd data(run.record.t.size(), columns.size());
+    data << run.record.t, run.record.q, run.record.tau;
+    write_csv(path(file), columns, data);
+  }
+  const auto r = run("payload --robot puma560 --link link6 --frame '0.01 0 0.05 0 0 0.3' --data " +
+                     path("loaded.csv") + " --reference " + path("unloaded.csv") +
+                     " --estimator wls --out " + path("load.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = json("load.json");
+  EXPECT_EQ(j.at("model"), "joint_torques");
+  EXPECT_EQ(j.at("determined_by_torques").size(), 10u) << j.at("determined_by_torques").dump();
+  expect_truth_inside(j, phi);
+  EXPECT_NEAR(j.at("mass").get<double>(), 1.910, 0.1);
+  const auto json_ref = run("payload --robot puma560 --link link6 --data " + path("loaded.csv") +
+                            " --reference result.json --out " + path("x.json"));
+  EXPECT_EQ(json_ref.code, 2);
+  EXPECT_NE(json_ref.err.find("not supported yet"), std::string::npos) << json_ref.err;
 }
 
 TEST_F(PayloadCli, BadInputsGiveOneErrorLine) {
