@@ -79,7 +79,8 @@ nlohmann::json parameter_json(const LoadIdentificationResult& r) {
   for (std::size_t j = 0; j < r.names.size(); ++j) {
     const auto i = static_cast<Eigen::Index>(j);
     list.push_back({{"name", r.names[j]},
-                    {"value", json_number(e.x(i))},
+                    // A parameter the data do not determine has no value worth a number.
+                    {"value", std::isfinite(e.std_dev(i)) ? json_number(e.x(i)) : nlohmann::json()},
                     {"std", json_number(e.std_dev(i))},
                     {"relative_std_percent", json_number(e.relative_std_percent(i))},
                     {"ci_low", json_number(e.ci_lower(i))},
