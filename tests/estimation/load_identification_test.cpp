@@ -330,24 +330,13 @@ TEST(LoadIdentification, IdenticalStandingPosesAreAnError) {
 TEST(LoadIdentification, SlowMotionLeavesTheInertiasNotExcited) {
   const Eigen::VectorXd phi = table_one_load();
   Rig rig = random_rig(phi, 13);
-  LoadRun run = simulate(rig, 2.0, 200.0);
   // The same path twenty times slower: gravity dominates, inertial forces vanish in the noise.
-  run.record.t *= 20.0;
-  run.record.dq /= 20.0;
-  run.record.ddq /= 400.0;
-  // Recompute the wrench for the slow motion by the independent Newton–Euler path.
-  Workspace ws(rig.loaded);
-  Eigen::VectorXd tau(kJoints + 1);
-  RneaOptions rnea_options;
-  rnea_options.joint_terms = false;
-  for (Eigen::Index k = 0; k < run.record.t.size(); ++k) {
-    Eigen::VectorXd q7 = Eigen::VectorXd::Zero(kJoints + 1), dq7 = q7, ddq7 = q7;
-    q7.head(kJoints) = run.record.q.row(k).transpose();
-    dq7.head(kJoints) = run.record.dq.row(k).transpose();
-    ddq7.head(kJoints) = run.record.ddq.row(k).transpose();
-    rnea(rig.loaded, ws, q7, dq7, ddq7, tau, rnea_options);
-    run.reading.row(k) << -ws.links[kJoints].f.transpose(), -ws.links[kJoints].n.transpose();
-  }
+  const Motion slow = [](double t, Eigen::VectorXd& q, Eigen::VectorXd& dq, Eigen::VectorXd& ddq) {
+    trajectory(t / 20.0, q, dq, ddq);
+    dq /= 20.0;
+    ddq /= 400.0;
+  };
+  LoadRun run = simulate(rig, 40.0, 10.0, 0.0, slow);
   add_noise(run.reading, 13, 0.05, 0.003);
   const LoadIdentificationResult r = identify(rig, run, {}, LoadEstimator::kWls);
   EXPECT_EQ(r.not_excited, (std::vector<std::string>{"Ixx", "Ixy", "Ixz", "Iyy", "Iyz", "Izz"}));

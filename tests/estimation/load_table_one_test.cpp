@@ -44,39 +44,21 @@ Model irp6_with_wrist() {
 const double kFrom[5] = {-40 * kDeg, 10 * kDeg, -30 * kDeg, 30 * kDeg, -150 * kDeg};
 const double kTo[5] = {30 * kDeg, -20 * kDeg, 40 * kDeg, -10 * kDeg, -10 * kDeg};
 
-LoadRun polynomial_run(const Rig& rig, double rate) {
-  const int n = rig.robot.dof();
-  const auto m = static_cast<Eigen::Index>(std::lround(kDuration * rate)) + 1;
-  LoadRun run;
-  run.record.t.resize(m);
-  run.record.q.resize(m, n);
-  run.record.dq.resize(m, n);
-  run.record.ddq.resize(m, n);
-  run.reading.resize(m, 6);
-  Workspace ws(rig.loaded);
-  Eigen::VectorXd q = Eigen::VectorXd::Zero(n + 1), dq = q, ddq = q, tau(n + 1);
-  RneaOptions options;
-  options.joint_terms = false;
-  for (Eigen::Index k = 0; k < m; ++k) {
-    const double t = static_cast<double>(k) / rate, s = t / kDuration;
-    // 10s³ − 15s⁴ + 6s⁵: zero velocity and acceleration at both ends.
-    const double p = s * s * s * (10 - 15 * s + 6 * s * s);
-    const double dp = 30 * s * s * (1 - s) * (1 - s) / kDuration;
-    const double ddp = 60 * s * (1 - s) * (1 - 2 * s) / (kDuration * kDuration);
-    for (int j = 0; j < n; ++j) {
-      const double span = kTo[j] - kFrom[j];
-      q(j) = kFrom[j] + span * p;
-      dq(j) = span * dp;
-      ddq(j) = span * ddp;
-    }
-    run.record.t(k) = t;
-    run.record.q.row(k) = q.head(n).transpose();
-    run.record.dq.row(k) = dq.head(n).transpose();
-    run.record.ddq.row(k) = ddq.head(n).transpose();
-    rnea(rig.loaded, ws, q, dq, ddq, tau, options);
-    run.reading.row(k) << -ws.links[n].f.transpose(), -ws.links[n].n.transpose();
+// Rest to rest: 10s³ − 15s⁴ + 6s⁵ has zero velocity and acceleration at both ends.
+void polynomial_motion(double t, Eigen::VectorXd& q, Eigen::VectorXd& dq, Eigen::VectorXd& ddq) {
+  q.resize(5);
+  dq.resize(5);
+  ddq.resize(5);
+  const double s = t / kDuration;
+  const double p = s * s * s * (10 - 15 * s + 6 * s * s);
+  const double dp = 30 * s * s * (1 - s) * (1 - s) / kDuration;
+  const double ddp = 60 * s * (1 - s) * (1 - 2 * s) / (kDuration * kDuration);
+  for (int j = 0; j < 5; ++j) {
+    const double span = kTo[j] - kFrom[j];
+    q(j) = kFrom[j] + span * p;
+    dq(j) = span * dp;
+    ddq(j) = span * ddp;
   }
-  return run;
 }
 
 TEST(LoadTableOne, SteelCuboidOnIrp6BothModels) {
@@ -90,7 +72,7 @@ TEST(LoadTableOne, SteelCuboidOnIrp6BothModels) {
   mount.link = 4;
   mount.p_LS = Eigen::Vector3d(0.0, 0.0, 0.1);
   const Rig rig = make_rig(irp6_with_wrist(), truth, mount);
-  LoadRun run = polynomial_run(rig, 1000.0);
+  LoadRun run = simulate(rig, kDuration, 1000.0, 0.0, polynomial_motion);
   // JR3-like noise: 0.05 N on the forces, 0.003 N m on the moments.
   add_noise(run.reading, 2026, 0.05, 0.003);
   const SensorMotion motion = sensor_motion_from_joints(rig.robot, run.record, rig.mount);

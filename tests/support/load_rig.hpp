@@ -5,6 +5,7 @@
 // an extra link (not from the load regressor K), the motion from analytic joint sines.
 
 #include <cmath>
+#include <functional>
 #include <random>
 
 #include <Eigen/Core>
@@ -94,36 +95,42 @@ struct LoadRun {
   Eigen::MatrixXd reading;  // m×6: what the sensor reports (force of the load on the sensor)
 };
 
-// The run from t0 to t0 + duration; record.tau holds the joint torques of the loaded robot (rigid
-// body only: the loaded model's joint terms are left out).
-inline LoadRun simulate(const Rig& rig, double duration, double rate, double t0 = 0.0) {
+// Joint motion at time t: q, dq, ddq (sized by the callee to the robot's joint count).
+using Motion = std::function<void(double, Eigen::VectorXd&, Eigen::VectorXd&, Eigen::VectorXd&)>;
+
+// The run from t0 to t0 + duration along `motion`; record.tau holds the joint torques of the
+// loaded robot (rigid body only: the loaded model's joint terms are left out).
+inline LoadRun simulate(const Rig& rig, double duration, double rate, double t0 = 0.0,
+                        const Motion& motion = trajectory) {
+  const int n = rig.robot.dof();
   const auto m = static_cast<Eigen::Index>(std::lround(duration * rate)) + 1;
   LoadRun run;
   run.record.t.resize(m);
-  run.record.q.resize(m, kJoints);
-  run.record.dq.resize(m, kJoints);
-  run.record.ddq.resize(m, kJoints);
+  run.record.q.resize(m, n);
+  run.record.dq.resize(m, n);
+  run.record.ddq.resize(m, n);
   run.reading.resize(m, 6);
-  run.record.tau.resize(m, kJoints);
+  run.record.tau.resize(m, n);
   Workspace ws(rig.loaded);
-  Eigen::VectorXd q, dq, ddq, tau(kJoints + 1);
+  Eigen::VectorXd q, dq, ddq, tau(n + 1);
+  // The load's joint is held at zero: its frame is the sensor frame.
+  Eigen::VectorXd q_all = Eigen::VectorXd::Zero(n + 1), dq_all = q_all, ddq_all = q_all;
   RneaOptions options;
   options.joint_terms = false;
   for (Eigen::Index k = 0; k < m; ++k) {
     const double t = t0 + static_cast<double>(k) / rate;
-    trajectory(t, q, dq, ddq);
+    motion(t, q, dq, ddq);
     run.record.t(k) = t;
     run.record.q.row(k) = q.transpose();
     run.record.dq.row(k) = dq.transpose();
     run.record.ddq.row(k) = ddq.transpose();
-    Eigen::VectorXd q7 = Eigen::VectorXd::Zero(kJoints + 1), dq7 = q7, ddq7 = q7;
-    q7.head(kJoints) = q;
-    dq7.head(kJoints) = dq;
-    ddq7.head(kJoints) = ddq;
-    rnea(rig.loaded, ws, q7, dq7, ddq7, tau, options);
-    run.record.tau.row(k) = tau.head(kJoints).transpose();
-    run.reading.row(k).head<3>() = -ws.links[kJoints].f.transpose();
-    run.reading.row(k).tail<3>() = -ws.links[kJoints].n.transpose();
+    q_all.head(n) = q;
+    dq_all.head(n) = dq;
+    ddq_all.head(n) = ddq;
+    rnea(rig.loaded, ws, q_all, dq_all, ddq_all, tau, options);
+    run.record.tau.row(k) = tau.head(n).transpose();
+    run.reading.row(k).head<3>() = -ws.links[n].f.transpose();
+    run.reading.row(k).tail<3>() = -ws.links[n].n.transpose();
   }
   return run;
 }
