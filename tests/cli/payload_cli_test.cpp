@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "dynid/dynamics/kinematics.hpp"
 #include "dynid/io/csv_writer.hpp"
 #include "dynid/model/robots.hpp"
 #include "support/cli_run.hpp"
@@ -138,6 +139,56 @@ TEST_F(PayloadCli, StaticPosesFromQuaternionsWithBiases) {
   }
   EXPECT_TRUE(j.at("inertia_com").is_null());
   EXPECT_TRUE(j.contains("not_reported"));
+}
+
+// A pose/IMU log without a robot model: quaternion, angular velocity and acceleration, linear
+// acceleration of the sensor origin (all from the rig's kinematics), moving; and the same rig's
+// joint positions as standing poses through --robot --static.
+TEST_F(PayloadCli, QuaternionLogAndStandingJointPoses) {
+  const Rig rig = puma_rig();
+  LoadRun sim = simulate(rig, 3.0, 250.0);
+  add_noise(sim.reading, 6, 0.05, 0.003);
+  const SensorMotion motion = sensor_motion_from_joints(rig.robot, sim.record, rig.mount);
+  Workspace ws(rig.robot);
+  const Eigen::Index m = sim.record.t.size();
+  Eigen::MatrixXd data(m, 20);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    forward_kinematics(rig.robot, ws, sim.record.q.row(k).transpose());
+    const Eigen::Quaterniond q(ws.links[rig.mount.link].R_WJ * rig.mount.R_LS);
+    data.row(k) << sim.record.t(k), q.x(), q.y(), q.z(), q.w(), motion.w.row(k), motion.dw.row(k),
+        motion.a.row(k), sim.reading.row(k);
+  }
+  write_csv(path("imu.csv"), {"t",   "qx", "qy", "qz", "qw", "wx", "wy", "wz", "dwx", "dwy",
+                              "dwz", "ax", "ay", "az", "fx", "fy", "fz", "mx", "my",  "mz"},
+            data);
+  auto r = run("payload --estimator wls --data " + path("imu.csv") + " --out " + path("load.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  expect_truth_inside(json("load.json"), table_one_load());
+  fs::remove(path("load.json"));
+  // Every 50th row as a standing pose of the arm (joint positions only, wrench of the load at
+  // rest).
+  const Eigen::VectorXd phi = table_one_load();
+  std::vector<std::string> columns;
+  for (int j = 1; j <= kJoints; ++j) columns.push_back("q" + std::to_string(j));
+  for (const auto& c : kWrench) columns.push_back(c);
+  Eigen::MatrixXd poses(m / 50, columns.size());
+  for (Eigen::Index k = 0; k < poses.rows(); ++k) {
+    const Eigen::Vector3d g = motion.g.row(50 * k).transpose();
+    const Eigen::Vector3d force = phi(0) * g, moment = (phi.segment<3>(1) / phi(0)).cross(force);
+    poses.row(k) << sim.record.q.row(50 * k), force.transpose(), moment.transpose();
+  }
+  write_csv(path("poses.csv"), columns, poses);
+  r =
+      run("payload --static --robot puma560 --sensor-link link6 --sensor-pose '0.01 0 0.05 0 0 "
+          "0.3' --data " +
+          path("poses.csv") + " --out " + path("load.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = json("load.json");
+  ASSERT_EQ(j.at("parameters").size(), 4u);
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_NEAR(j.at("parameters")[k].at("value").get<double>(), phi(static_cast<Eigen::Index>(k)),
+                1e-9);
+  }
 }
 
 TEST_F(PayloadCli, RecursiveEstimatorWritesItsHistory) {
