@@ -14,6 +14,7 @@ void add_commands(CLI::App& app) {
   add_simulate_command(app);
   add_average_command(app);
   add_demo_command(app);
+  add_payload_command(app);
   check_numeric_flags(app);
 }
 

@@ -36,4 +36,7 @@ void add_simulate_command(CLI::App& app);
 /// `dynid average`: mean period and noise statistics of a periodic run (cmd_average.cpp).
 void add_average_command(CLI::App& app);
 
+/// `dynid payload`: a gripped load's parameters from a wrist force/torque sensor (cmd_payload.cpp).
+void add_payload_command(CLI::App& app);
+
 }  // namespace dynid::cli

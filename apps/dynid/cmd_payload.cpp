@@ -1,0 +1,429 @@
+// `dynid payload`: a gripped load's inertial parameters from a wrist force/torque sensor (seed 1
+// §III). Parse, validate, call the library (estimation/load_identification.hpp), write JSON.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
+#include "dynid/estimation/load_identification.hpp"
+#include "dynid/io/csv_reader.hpp"
+#include "dynid/io/csv_writer.hpp"
+#include "dynid/io/joint_columns.hpp"
+#include "dynid/io/joint_record_file.hpp"
+#include "dynid/io/json_writer.hpp"
+#include "dynid/model/robots.hpp"
+#include "dynid/version.hpp"
+
+namespace dynid::cli {
+namespace {
+
+struct PayloadCliOptions {
+  std::string data, robot, sensor_link, sensor_pose, out, history, columns;
+  std::string link, reference, frame;  // joint-torque mode
+  std::string model = "differential";
+  std::string estimator = "ols";
+  std::string gravity = "0 0 -9.81";
+  double interval = 0.2, wrench_sign = 1.0, confidence = 0.999, cutoff = 0.0;
+  bool bias = false, standing = false, no_filter = false;
+};
+
+// "a b c ..." → exactly `count` finite numbers, or a usage error naming the flag.
+std::vector<double> numbers(const std::string& text, std::size_t count, const char* flag,
+                            const char* meaning) {
+  std::istringstream in(text);
+  std::vector<double> v;
+  std::string word;
+  while (in >> word) {
+    try {
+      std::size_t used = 0;
+      v.push_back(std::stod(word, &used));
+      if (used != word.size() || !std::isfinite(v.back())) throw std::invalid_argument(word);
+    } catch (const std::exception&) {
+      throw UsageError(std::string(flag) + " \"" + text + "\": '" + word +
+                       "' is not a finite number; give " + meaning);
+    }
+  }
+  if (v.size() != count) {
+    throw UsageError(std::string(flag) + " \"" + text + "\" has " + std::to_string(v.size()) +
+                     " numbers; give " + meaning);
+  }
+  return v;
+}
+
+// Columns `names` as an m×k block, or empty when none is present; some but not all is an error.
+Eigen::MatrixXd optional_columns(const CsvTable& table, const std::vector<std::string>& names) {
+  std::size_t present = 0;
+  for (const auto& name : names) present += table.find(name).has_value();
+  if (present == 0) return {};
+  Eigen::MatrixXd x(table.rows(), static_cast<Eigen::Index>(names.size()));
+  for (std::size_t c = 0; c < names.size(); ++c) {
+    // index() names the file, the missing column and the header when only some are present.
+    x.col(static_cast<Eigen::Index>(c)) = table.data.col(table.index(names[c]));
+  }
+  return x;
+}
+
+nlohmann::json parameter_json(const LoadIdentificationResult& r) {
+  nlohmann::json list = nlohmann::json::array();
+  const Estimate& e = r.estimate;
+  for (std::size_t j = 0; j < r.names.size(); ++j) {
+    const auto i = static_cast<Eigen::Index>(j);
+    list.push_back({{"name", r.names[j]},
+                    // A parameter the data do not determine has no value worth a number.
+                    {"value", std::isfinite(e.std_dev(i)) ? json_number(e.x(i)) : nlohmann::json()},
+                    {"std", json_number(e.std_dev(i))},
+                    {"relative_std_percent", json_number(e.relative_std_percent(i))},
+                    {"ci_low", json_number(e.ci_lower(i))},
+                    {"ci_high", json_number(e.ci_upper(i))}});
+  }
+  return list;
+}
+
+// The result JSON (docs/cli.md, `dynid payload`), the echo on stderr, the RLS history.
+void write_result(const PayloadCliOptions& cli, const LoadIdentificationResult& r,
+                  const char* model_name, const nlohmann::json& frame, const nlohmann::json& extra,
+                  const std::vector<std::pair<std::string, std::string>>& choices,
+                  const std::vector<std::string>& group_names, bool with_inertia) {
+  const Estimate& e = r.estimate;
+  const bool mass_known =
+      std::find(r.not_excited.begin(), r.not_excited.end(), "m") == r.not_excited.end();
+  nlohmann::json out = {
+      {"command", "payload"},
+      {"model", model_name},
+      {"estimator", to_string(e.summary.estimator)},
+      {"frame", frame},
+      {"confidence_level", e.confidence_level},
+      {"covariance", e.covariance_kind},
+      {"parameters", parameter_json(r)},
+      {"mass", mass_known ? json_number(e.x(0)) : nlohmann::json()},
+      {"com", r.physics.mass > 0.0
+                  ? nlohmann::json{json_number(r.physics.com.x()), json_number(r.physics.com.y()),
+                                   json_number(r.physics.com.z())}
+                  : nlohmann::json()},
+      {"physically_consistent", r.physics.consistent},
+      {"consistency_violation", r.physics.violated},
+      {"not_excited", r.not_excited},
+      {"residual_rms", json_number(e.residual_rms)},
+      {"relative_error", json_number(e.relative_error)},
+      {"condition_number", json_number(e.summary.condition_number)},
+      {"rows", e.summary.rows},
+      {"warnings", e.summary.warnings},
+      {"version", kVersion}};
+  out.update(extra);
+  if (with_inertia && r.physics.mass > 0.0) {
+    const Eigen::Matrix3d& I = r.physics.inertia_com;
+    out["inertia_com"] = {{"Ixx", I(0, 0)}, {"Ixy", I(0, 1)}, {"Ixz", I(0, 2)},
+                          {"Iyy", I(1, 1)}, {"Iyz", I(1, 2)}, {"Izz", I(2, 2)}};
+  } else {
+    out["inertia_com"] = nullptr;
+    if (!with_inertia) {
+      out["not_reported"] =
+          "inertias: standing poses determine only the mass, the first moments "
+          "and the offsets";
+    }
+  }
+  nlohmann::json per_component = nlohmann::json::object();
+  for (std::size_t c = 0; c < group_names.size(); ++c) {
+    per_component[group_names[c]] =
+        json_number(e.group_rms.size() ? e.group_rms(static_cast<Eigen::Index>(c)) : NAN);
+  }
+  out["residual_rms_per_component"] = per_component;
+  nlohmann::json choice_json = nlohmann::json::object();
+  for (const auto& [key, value] : choices) choice_json[key] = value;
+  out["choices"] = choice_json;
+  for (const auto& [key, value] : choices) {
+    std::cerr << "payload: " << key << ": " << one_line(value) << '\n';
+  }
+  for (const auto& w : e.summary.warnings) std::cerr << "warning: " << one_line(w) << '\n';
+  if (!r.physics.consistent) {
+    std::cerr << "warning: the identified load is not physically consistent: "
+              << one_line(r.physics.violated) << '\n';
+  }
+  write_json(cli.out, out);
+  if (!cli.history.empty()) {
+    std::vector<std::string> columns = {"row"};
+    for (const auto& name : r.names) columns.push_back(name);
+    Eigen::MatrixXd history(r.history.rows(), r.history.cols() + 1);
+    history.col(0) =
+        Eigen::VectorXd::LinSpaced(r.history.rows(), 1.0, static_cast<double>(r.history.rows()));
+    history.rightCols(r.history.cols()) = r.history;
+    write_csv(cli.history, columns, history);
+  }
+  std::cout << "payload: m "
+            << (mass_known ? "= " + std::to_string(e.x(0)) + " kg" : "not determined");
+  if (r.physics.mass > 0.0) std::cout << ", c = " << r.physics.com.transpose() << " m";
+  std::cout << (r.physics.consistent ? ", physically consistent" : ", NOT physically consistent")
+            << "; wrote " << cli.out << '\n';
+}
+
+// `--link LINK --reference unloaded.csv`: robot and load together from joint torques.
+void run_payload_from_torques(const PayloadCliOptions& cli, LoadIdentificationOptions options) {
+  if (cli.robot.empty())
+    throw UsageError("--link needs --robot R: the robot that carries the load");
+  if (cli.reference.empty()) {
+    throw UsageError("--link needs --reference: a run of the robot without the load (CSV)");
+  }
+  if (cli.reference.size() >= 5 && cli.reference.substr(cli.reference.size() - 5) == ".json") {
+    throw UsageError("--reference '" + cli.reference +
+                     "': an identify result as reference is not supported yet; give a CSV run "
+                     "of the robot without the load (t, q*, tau*)");
+  }
+  if (cli.standing || !cli.sensor_link.empty() || !cli.sensor_pose.empty() || cli.bias) {
+    throw UsageError(
+        "--link (load from joint torques) does not take --static, --bias, "
+        "--sensor-link or --sensor-pose; use --frame to place the load's frame");
+  }
+  const Model model = load_robot(cli.robot);
+  LoadFrame frame;
+  if (!cli.frame.empty()) {
+    const auto pose = numbers(cli.frame, 6, "--frame",
+                              "\"x y z roll pitch yaw\" [m, rad] of the frame in the link frame");
+    frame.p_LF = Eigen::Vector3d(pose[0], pose[1], pose[2]);
+    frame.R_LF = roll_pitch_yaw(pose[3], pose[4], pose[5]);
+  }
+  const int link = find_link(model, cli.link);
+  RunFileOptions file;
+  file.columns = parse_column_mapping(cli.columns);
+  const JointRecord loaded_raw = read_joint_record(cli.data, model, file);
+  const JointRecord unloaded_raw = read_joint_record(cli.reference, model, file);
+  SignalOptions signal;
+  signal.filter = !cli.no_filter;
+  signal.cutoff_hz = cli.cutoff;
+  std::vector<std::pair<std::string, std::string>> choices, reference_choices;
+  const JointRecord loaded = preprocess(loaded_raw, signal, choices).record;
+  const JointRecord unloaded = preprocess(unloaded_raw, signal, reference_choices).record;
+  // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
+  options.hac_covariance = signal.filter;
+  options.record_history = false;
+  const LoadIdentificationResult r = identify_load_from_torques(
+      model, link, frame, ParameterLayout::full(), loaded, unloaded, options);
+  std::vector<std::string> joints;
+  for (const auto& joint : model.joints) joints.push_back(joint.name);
+  const nlohmann::json where = {{"robot", model.name},
+                                {"link", model.joints[link].link_name},
+                                {"frame", cli.frame.empty() ? "link frame" : cli.frame}};
+  const nlohmann::json extra = {
+      {"reference", cli.reference},
+      {"determined_by_torques", [&] {
+         std::vector<std::string> names;
+         for (const auto& name : r.names) {
+           if (std::find(r.not_excited.begin(), r.not_excited.end(), name) == r.not_excited.end())
+             names.push_back(name);
+         }
+         return names;
+       }()}};
+  write_result(cli, r, "joint_torques", where, extra, choices, joints, true);
+}
+
+void run_payload(const PayloadCliOptions& cli) {
+  if (cli.out.empty()) throw UsageError("--out is required: the JSON file to write");
+  LoadEquationOptions equations;
+  if (cli.model == "differential") {
+    equations.model = LoadModelKind::kDifferential;
+  } else if (cli.model == "integral") {
+    equations.model = LoadModelKind::kIntegral;
+  } else {
+    throw UsageError("--model '" + cli.model + "': use differential or integral");
+  }
+  if (cli.standing) equations.model = LoadModelKind::kStatic;
+  if (!(cli.wrench_sign == 1.0 || cli.wrench_sign == -1.0)) {
+    throw UsageError(
+        "--wrench-sign must be 1 (force of the load on the sensor, as sensor drivers "
+        "report it) or -1 (force of the sensor on the load)");
+  }
+  if (!(cli.interval > 0.0)) throw UsageError("--interval must be a positive window in seconds");
+  equations.interval = cli.interval;
+  equations.bias = cli.bias;
+  equations.wrench_sign = cli.wrench_sign;
+  LoadIdentificationOptions options;
+  options.confidence_level = cli.confidence;
+  if (cli.estimator == "ols") {
+    options.estimator = LoadEstimator::kOls;
+  } else if (cli.estimator == "wls") {
+    options.estimator = LoadEstimator::kWls;
+  } else if (cli.estimator == "rls") {
+    options.estimator = LoadEstimator::kRls;
+  } else {
+    throw UsageError("--estimator '" + cli.estimator + "': use ols, wls or rls");
+  }
+  if (!cli.history.empty() && options.estimator != LoadEstimator::kRls) {
+    throw UsageError("--history needs --estimator rls (the estimate after every wrench sample)");
+  }
+  options.record_history = !cli.history.empty();
+  if (!cli.link.empty()) return run_payload_from_torques(cli, options);
+  if (!cli.robot.empty() && cli.sensor_link.empty()) {
+    throw UsageError("--robot needs --sensor-link LINK: the link that carries the sensor");
+  }
+  if (cli.robot.empty() && (!cli.sensor_link.empty() || !cli.sensor_pose.empty())) {
+    throw UsageError(
+        "--sensor-link and --sensor-pose need --robot (or give the sensor's own "
+        "orientation qx qy qz qw in the data)");
+  }
+
+  CsvTable table = read_csv(cli.data);
+  apply_column_mapping(table, parse_column_mapping(cli.columns));
+  const std::vector<std::string> wrench_names = {"fx", "fy", "fz", "mx", "my", "mz"};
+  std::string missing;
+  for (const auto& name : wrench_names) {
+    if (!table.find(name)) missing += (missing.empty() ? "" : " ") + name;
+  }
+  if (!missing.empty()) {
+    throw Error("--data '" + cli.data + "' has no wrench column(s) " + missing +
+                "; the sensor reading needs fx fy fz mx my mz [N, N m] (rename with --columns)");
+  }
+  Eigen::MatrixXd wrench(table.rows(), 6);
+  for (int c = 0; c < 6; ++c) wrench.col(c) = table.data.col(table.index(wrench_names[c]));
+  const auto t_column = equations.model == LoadModelKind::kStatic ? std::optional<Eigen::Index>()
+                                                                  : checked_time_column(table);
+  if (equations.model != LoadModelKind::kStatic && !t_column) {
+    throw Error("--data '" + cli.data +
+                "' has no t column; a moving load needs time stamps (or give --static for "
+                "standing poses)");
+  }
+  const Eigen::VectorXd t =
+      t_column ? Eigen::VectorXd(table.data.col(*t_column)) : Eigen::VectorXd();
+
+  std::vector<std::pair<std::string, std::string>> choices;
+  SensorMotion motion;
+  nlohmann::json frame;
+  if (!cli.robot.empty()) {
+    const Model model = load_robot(cli.robot);
+    SensorMount mount;
+    mount.link = find_link(model, cli.sensor_link);
+    if (!cli.sensor_pose.empty()) {
+      const auto pose =
+          numbers(cli.sensor_pose, 6, "--sensor-pose",
+                  "\"x y z roll pitch yaw\" [m, rad] of the sensor in the link frame");
+      mount.p_LS = Eigen::Vector3d(pose[0], pose[1], pose[2]);
+      mount.R_LS = roll_pitch_yaw(pose[3], pose[4], pose[5]);
+    }
+    std::vector<std::string> joint_names;
+    for (const auto& joint : model.joints) joint_names.push_back(joint.name);
+    JointRecord record;
+    record.t = t;
+    record.q = joint_signal(table, joint_names, "q");
+    if (equations.model == LoadModelKind::kStatic) {
+      motion = sensor_motion_from_joints(model, record, mount);
+    } else {
+      if (has_joint_columns(table.columns, joint_names, "dq"))
+        record.dq = joint_signal(table, joint_names, "dq");
+      if (has_joint_columns(table.columns, joint_names, "ddq"))
+        record.ddq = joint_signal(table, joint_names, "ddq");
+      SignalOptions signal;
+      signal.filter = !cli.no_filter;
+      signal.cutoff_hz = cli.cutoff;
+      PreparedLoadRun run = prepare_load_run(record, wrench, signal, choices);
+      // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
+      options.hac_covariance = signal.filter;
+      wrench = std::move(run.wrench);
+      motion = sensor_motion_from_joints(model, run.record, mount);
+    }
+    frame = {{"robot", model.name}, {"sensor_link", model.joints[mount.link].link_name}};
+  } else {
+    const std::vector<std::string> quat_names = {"qx", "qy", "qz", "qw"};
+    OrientationLog log;
+    log.quaternion = optional_columns(table, quat_names);
+    if (log.quaternion.size() == 0) {
+      throw Error("--data '" + cli.data +
+                  "' has neither the sensor orientation qx qy qz qw nor joint data: give the "
+                  "quaternion columns, or joint columns q1..qn with --robot R --sensor-link LINK");
+    }
+    if (equations.model != LoadModelKind::kStatic) {
+      log.t = t;
+      log.w = optional_columns(table, {"wx", "wy", "wz"});
+      log.dw = optional_columns(table, {"dwx", "dwy", "dwz"});
+      log.a = optional_columns(table, {"ax", "ay", "az"});
+    }
+    const auto g = numbers(cli.gravity, 3, "--gravity", "\"gx gy gz\" in m/s^2, base frame");
+    motion = sensor_motion_from_orientation(log, Eigen::Vector3d(g[0], g[1], g[2]), choices);
+    frame = {{"orientation", "qx qy qz qw from the data"}};
+  }
+  const EquationBlock block = load_equations(motion, wrench, equations);
+  const LoadIdentificationResult r = identify_load(block, options);
+  const char* model_name = equations.model == LoadModelKind::kStatic     ? "static"
+                           : equations.model == LoadModelKind::kIntegral ? "integral"
+                                                                         : "differential";
+  nlohmann::json extra = {{"wrench_sign", cli.wrench_sign}};
+  if (equations.model == LoadModelKind::kIntegral) extra["interval"] = cli.interval;
+  write_result(cli, r, model_name, frame, extra, choices, block.group_names,
+               equations.model != LoadModelKind::kStatic);
+}
+
+}  // namespace
+
+void add_payload_command(CLI::App& app) {
+  auto o = std::make_shared<PayloadCliOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "payload",
+      "Inertial parameters of a gripped load (m, mc, inertia about the sensor origin) from a "
+      "wrist force/torque sensor: Dutkiewicz, Kozlowski, Wroblewski, \"Experimental "
+      "Identification of Robot and Load Dynamic Parameters\" (1993)");
+  cmd->add_option("--data,-d", o->data,
+                  "CSV with the sensor reading fx fy fz mx my mz [N, N m] in the sensor frame "
+                  "(the force and moment the load exerts on the sensor, as drivers report it), t "
+                  "[s] unless --static, and either joint columns q1..qn (with --robot) or the "
+                  "sensor orientation qx qy qz qw (unit quaternion, sensor frame in the base "
+                  "frame) with optional wx wy wz, dwx dwy dwz, ax ay az (sensor frame)")
+      ->required();
+  cmd->add_option("--out,-o", o->out, "JSON result to write (atomically)")->required();
+  cmd->add_option("--robot,-r", o->robot,
+                  "Built-in robot name or .urdf / .yaml model: the sensor's motion comes from "
+                  "its kinematics and q (dq, ddq derived and filtered as in identify)");
+  cmd->add_option("--sensor-link", o->sensor_link, "Link (or joint) name that carries the sensor");
+  cmd->add_option("--sensor-pose", o->sensor_pose,
+                  "\"x y z roll pitch yaw\" of the sensor frame in the link frame [m, rad], URDF "
+                  "roll-pitch-yaw convention; default: the link frame");
+  cmd->add_option("--model", o->model,
+                  "differential (per-sample wrench equations) or integral (wrench integrated "
+                  "over windows of --interval, no accelerations needed)")
+      ->capture_default_str();
+  cmd->add_option("--interval", o->interval,
+                  "Integral model: window length [s] (consecutive, non-overlapping)")
+      ->capture_default_str();
+  cmd->add_flag("--bias", o->bias,
+                "Identify the six constant sensor offsets fx0 fy0 fz0 mx0 my0 mz0 too");
+  cmd->add_flag("--static", o->standing,
+                "Rows are standing poses (no t needed): only m, mc (and offsets) are "
+                "identifiable, inertias are not reported");
+  cmd->add_option("--wrench-sign", o->wrench_sign,
+                  "1: columns are the force of the load on the sensor (a load at rest reads "
+                  "+m g); -1: the force of the sensor on the load")
+      ->capture_default_str();
+  cmd->add_option("--estimator", o->estimator,
+                  "ols, wls (one noise variance per wrench component) or rls (U-D recursive "
+                  "least squares)")
+      ->capture_default_str();
+  cmd->add_option("--history", o->history,
+                  "With --estimator rls: CSV of the estimate after every wrench equation");
+  cmd->add_option("--confidence", o->confidence, "Student-t interval level in (0, 1)")
+      ->capture_default_str();
+  cmd->add_option("--gravity", o->gravity,
+                  "Without --robot: gravity \"gx gy gz\" in the base frame [m/s^2]")
+      ->capture_default_str();
+  cmd->add_option("--cutoff", o->cutoff,
+                  "With --robot: low-pass cut-off [Hz] for q and the wrench; 0 = automatic");
+  cmd->add_flag("--no-filter", o->no_filter, "With --robot: do not low-pass q and the wrench");
+  cmd->add_option("--columns", o->columns, "Rename input columns: from=to,from=to");
+  cmd->add_option("--link", o->link,
+                  "Without a sensor: the link (or joint) that carries the load; --data is then a "
+                  "run with the load (t, q*, tau*) and --reference one without it");
+  cmd->add_option("--reference", o->reference,
+                  "With --link: CSV run of the robot without the load (same or another "
+                  "trajectory); robot and load are identified together");
+  cmd->add_option("--frame", o->frame,
+                  "With --link: \"x y z roll pitch yaw\" of the frame (e.g. the tool flange) in "
+                  "the link frame [m, rad] in which the load is reported; default the link frame");
+  cmd->callback([o] { run_payload(*o); });
+}
+
+}  // namespace dynid::cli

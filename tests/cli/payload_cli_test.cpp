@@ -1,0 +1,284 @@
+// `dynid payload` end to end: wrenches of a known load computed by RNEA of the puma560 carrying it
+// (tests/support/load_rig.hpp), with sensor noise, through the CSV, the command and its JSON.
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <tuple>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "dynid/dynamics/kinematics.hpp"
+#include "dynid/io/csv_writer.hpp"
+#include "dynid/model/robots.hpp"
+#include "support/cli_run.hpp"
+#include "support/load_rig.hpp"
+
+namespace dynid {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace load_rig;
+
+class PayloadCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("dynid_payload_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  testing::CliResult run(const std::string& args) const { return testing::run_dynid(args, dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  nlohmann::json json(const std::string& name) const {
+    return nlohmann::json::parse(testing::slurp(dir_ / name));
+  }
+  // Exit code, one error line naming `part`, no result file.
+  void expect_error(const testing::CliResult& r, int code, const std::string& part) const {
+    EXPECT_EQ(r.code, code) << r.err;
+    EXPECT_EQ(testing::error_contract_problem(r.err), "") << r.err;
+    EXPECT_NE(r.err.find(part), std::string::npos) << r.err << "\nexpected: " << part;
+    EXPECT_FALSE(fs::exists(dir_ / "load.json"));
+  }
+  fs::path dir_;
+};
+
+Rig puma_rig() {
+  SensorMount mount;
+  mount.link = 5;
+  mount.p_LS = Eigen::Vector3d(0.01, 0.0, 0.05);
+  mount.R_LS = roll_pitch_yaw(0.0, 0.0, 0.3);
+  return make_rig(load_robot("puma560"), table_one_load(), mount);
+}
+
+const std::vector<std::string> kWrench = {"fx", "fy", "fz", "mx", "my", "mz"};
+
+// t, q1..q6, fx..mz of a noisy run.
+void write_joint_run(const std::string& file, unsigned seed, double rate) {
+  LoadRun run = simulate(puma_rig(), 4.0, rate);
+  add_noise(run.reading, seed, 0.05, 0.003);
+  std::vector<std::string> columns = {"t"};
+  for (int j = 1; j <= kJoints; ++j) columns.push_back("q" + std::to_string(j));
+  for (const auto& c : kWrench) columns.push_back(c);
+  Eigen::MatrixXd data(run.record.t.size(), columns.size());
+  data << run.record.t, run.record.q, run.reading;
+  write_csv(file, columns, data);
+}
+
+void expect_truth_inside(const nlohmann::json& result, const Eigen::VectorXd& truth) {
+  const auto& parameters = result.at("parameters");
+  ASSERT_GE(parameters.size(), static_cast<std::size_t>(truth.size()));
+  const char* names[] = {"m",   "mcx", "mcy", "mcz", "Ixx", "Ixy", "Ixz", "Iyy",
+                         "Iyz", "Izz", "fx0", "fy0", "fz0", "mx0", "my0", "mz0"};
+  for (Eigen::Index j = 0; j < truth.size(); ++j) {
+    const auto& p = parameters[static_cast<std::size_t>(j)];
+    EXPECT_EQ(p.at("name"), names[j]);
+    EXPECT_LE(p.at("ci_low").get<double>(), truth(j)) << p.dump();
+    EXPECT_GE(p.at("ci_high").get<double>(), truth(j)) << p.dump();
+  }
+}
+
+TEST_F(PayloadCli, JointDataBothModelsRecoverTheLoad) {
+  write_joint_run(path("run.csv"), 1, 500.0);
+  for (const std::string model : {"differential", "integral"}) {
+    const auto r =
+        run("payload --robot puma560 --sensor-link link6 --sensor-pose '0.01 0 0.05 0 "
+            "0 0.3' --data " +
+            path("run.csv") + " --model " + model + " --estimator wls --out " + path("load.json"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    const nlohmann::json j = json("load.json");
+    SCOPED_TRACE(model);
+    expect_truth_inside(j, table_one_load());
+    EXPECT_TRUE(j.at("physically_consistent").get<bool>());
+    EXPECT_TRUE(j.at("not_excited").empty()) << j.at("not_excited").dump();
+    EXPECT_NEAR(j.at("mass").get<double>(), 1.910, 0.01);
+    EXPECT_NEAR(j.at("com")[2].get<double>(), 0.1394 / 1.910, 2e-3);
+    EXPECT_TRUE(j.at("inertia_com").contains("Izz"));
+    fs::remove(path("load.json"));
+  }
+}
+
+TEST_F(PayloadCli, StaticPosesFromQuaternionsWithBiases) {
+  const Eigen::VectorXd phi = table_one_load();
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const int poses = 15;
+  Eigen::MatrixXd data(poses, 10);
+  Eigen::Matrix<double, 6, 1> bias;
+  bias << 0.8, -1.2, 2.5, 0.04, -0.03, 0.06;
+  std::normal_distribution<double> f(0.0, 0.05), n(0.0, 0.003);
+  for (int k = 0; k < poses; ++k) {
+    const Eigen::Quaterniond q = Eigen::Quaterniond(u(rng), u(rng), u(rng), u(rng)).normalized();
+    // A load at rest: the sensor reads +m·g_S and c × (m·g_S).
+    const Eigen::Vector3d g_S = q.toRotationMatrix().transpose() * Eigen::Vector3d(0, 0, -9.81);
+    const Eigen::Vector3d force = phi(0) * g_S;
+    const Eigen::Vector3d moment = (phi.segment<3>(1) / phi(0)).cross(force);
+    data.row(k) << q.x(), q.y(), q.z(), q.w(), force.transpose() + bias.head<3>().transpose(),
+        moment.transpose() + bias.tail<3>().transpose();
+    for (int c = 4; c < 7; ++c) data(k, c) += f(rng);
+    for (int c = 7; c < 10; ++c) data(k, c) += n(rng);
+  }
+  write_csv(path("poses.csv"), {"qx", "qy", "qz", "qw", "fx", "fy", "fz", "mx", "my", "mz"}, data);
+  const auto r = run("payload --static --bias --estimator wls --data " + path("poses.csv") +
+                     " --out " + path("load.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = json("load.json");
+  Eigen::VectorXd truth(10);
+  truth << phi.head(4), bias;
+  const auto& p = j.at("parameters");
+  ASSERT_EQ(p.size(), 10u);
+  EXPECT_EQ(p[4].at("name"), "fx0");
+  for (std::size_t k = 0; k < 10; ++k) {
+    EXPECT_LE(p[k].at("ci_low").get<double>(), truth(static_cast<Eigen::Index>(k))) << p[k];
+    EXPECT_GE(p[k].at("ci_high").get<double>(), truth(static_cast<Eigen::Index>(k))) << p[k];
+  }
+  EXPECT_TRUE(j.at("inertia_com").is_null());
+  EXPECT_TRUE(j.contains("not_reported"));
+}
+
+// A pose/IMU log without a robot model: quaternion, angular velocity and acceleration, linear
+// acceleration of the sensor origin (all from the rig's kinematics), moving; and the same rig's
+// joint positions as standing poses through --robot --static.
+TEST_F(PayloadCli, QuaternionLogAndStandingJointPoses) {
+  const Rig rig = puma_rig();
+  LoadRun sim = simulate(rig, 3.0, 250.0);
+  add_noise(sim.reading, 6, 0.05, 0.003);
+  const SensorMotion motion = sensor_motion_from_joints(rig.robot, sim.record, rig.mount);
+  Workspace ws(rig.robot);
+  const Eigen::Index m = sim.record.t.size();
+  Eigen::MatrixXd data(m, 20);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    forward_kinematics(rig.robot, ws, sim.record.q.row(k).transpose());
+    const Eigen::Quaterniond q(ws.links[rig.mount.link].R_WJ * rig.mount.R_LS);
+    data.row(k) << sim.record.t(k), q.x(), q.y(), q.z(), q.w(), motion.w.row(k), motion.dw.row(k),
+        motion.a.row(k), sim.reading.row(k);
+  }
+  write_csv(path("imu.csv"), {"t",   "qx", "qy", "qz", "qw", "wx", "wy", "wz", "dwx", "dwy",
+                              "dwz", "ax", "ay", "az", "fx", "fy", "fz", "mx", "my",  "mz"},
+            data);
+  auto r = run("payload --estimator wls --data " + path("imu.csv") + " --out " + path("load.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  expect_truth_inside(json("load.json"), table_one_load());
+  fs::remove(path("load.json"));
+  // Every 50th row as a standing pose of the arm (joint positions only, wrench of the load at
+  // rest).
+  const Eigen::VectorXd phi = table_one_load();
+  std::vector<std::string> columns;
+  for (int j = 1; j <= kJoints; ++j) columns.push_back("q" + std::to_string(j));
+  for (const auto& c : kWrench) columns.push_back(c);
+  Eigen::MatrixXd poses(m / 50, columns.size());
+  for (Eigen::Index k = 0; k < poses.rows(); ++k) {
+    const Eigen::Vector3d g = motion.g.row(50 * k).transpose();
+    const Eigen::Vector3d force = phi(0) * g, moment = (phi.segment<3>(1) / phi(0)).cross(force);
+    poses.row(k) << sim.record.q.row(50 * k), force.transpose(), moment.transpose();
+  }
+  write_csv(path("poses.csv"), columns, poses);
+  r =
+      run("payload --static --robot puma560 --sensor-link link6 --sensor-pose '0.01 0 0.05 0 0 "
+          "0.3' --data " +
+          path("poses.csv") + " --out " + path("load.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = json("load.json");
+  ASSERT_EQ(j.at("parameters").size(), 4u);
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_NEAR(j.at("parameters")[k].at("value").get<double>(), phi(static_cast<Eigen::Index>(k)),
+                1e-9);
+  }
+}
+
+TEST_F(PayloadCli, RecursiveEstimatorWritesItsHistory) {
+  write_joint_run(path("run.csv"), 2, 200.0);
+  const auto r = run("payload --robot puma560 --sensor-link link6 --data " + path("run.csv") +
+                     " --sensor-pose '0.01 0 0.05 0 0 0.3' --estimator rls --history " +
+                     path("history.csv") + " --out " + path("load.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string history = testing::slurp(dir_ / "history.csv");
+  EXPECT_EQ(history.rfind("row,m,mcx,mcy,mcz,Ixx", 0), 0u) << history.substr(0, 80);
+  EXPECT_NEAR(json("load.json").at("mass").get<double>(), 1.910, 0.02);
+}
+
+// Without a sensor: a loaded and an unloaded run (t, q*, tau*), the load reported at a flange
+// frame.
+TEST_F(PayloadCli, JointTorquesWithAnUnloadedReference) {
+  const Eigen::VectorXd phi = table_one_load();
+  const Rig loaded = puma_rig();
+  const Rig unloaded = make_rig(load_robot("puma560"), Eigen::VectorXd::Zero(10), loaded.mount);
+  std::vector<std::string> columns = {"t"};
+  for (int j = 1; j <= kJoints; ++j) columns.push_back("q" + std::to_string(j));
+  for (int j = 1; j <= kJoints; ++j) columns.push_back("tau" + std::to_string(j));
+  for (const auto& [rig, t0, file, seed] : {std::tuple{&loaded, 0.0, "loaded.csv", 7u},
+                                            std::tuple{&unloaded, 6.0, "unloaded.csv", 8u}}) {
+    LoadRun run = simulate(*rig, 6.0, 200.0, t0);
+    add_noise(run.record.tau, seed, 0.02, 0.02);
+    Eigen::MatrixXd data(run.record.t.size(), columns.size());
+    data << run.record.t, run.record.q, run.record.tau;
+    write_csv(path(file), columns, data);
+  }
+  const auto r = run("payload --robot puma560 --link link6 --frame '0.01 0 0.05 0 0 0.3' --data " +
+                     path("loaded.csv") + " --reference " + path("unloaded.csv") +
+                     " --estimator wls --out " + path("load.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = json("load.json");
+  EXPECT_EQ(j.at("model"), "joint_torques");
+  EXPECT_EQ(j.at("determined_by_torques").size(), 10u) << j.at("determined_by_torques").dump();
+  expect_truth_inside(j, phi);
+  EXPECT_NEAR(j.at("mass").get<double>(), 1.910, 0.1);
+  const auto json_ref = run("payload --robot puma560 --link link6 --data " + path("loaded.csv") +
+                            " --reference result.json --out " + path("x.json"));
+  EXPECT_EQ(json_ref.code, 2);
+  EXPECT_NE(json_ref.err.find("not supported yet"), std::string::npos) << json_ref.err;
+}
+
+TEST_F(PayloadCli, BadInputsGiveOneErrorLine) {
+  write_joint_run(path("run.csv"), 4, 200.0);
+  const std::string robot =
+      "payload --robot puma560 --sensor-link link6 --out " + path("load.json") + " --data ";
+  expect_error(run("payload --robot puma560 --sensor-link tool0 --out " + path("load.json") +
+                   " --data " + path("run.csv")),
+               2, "'tool0'");
+  // Missing wrench columns.
+  std::ofstream(path("nowrench.csv")) << "t,q1,q2,q3,q4,q5,q6,fx,fy\n0,0,0,0,0,0,0,1,1\n";
+  expect_error(run(robot + path("nowrench.csv")), 1, "fz mx my mz");
+  // Zero-norm gravity, non-unit quaternion, too few / identical poses, no load.
+  std::ofstream(path("quat.csv")) << "qx,qy,qz,qw,fx,fy,fz,mx,my,mz\n"
+                                     "0,0,0,1,0,0,-18.7,0.1,0.2,0\n"
+                                     "0,0,0,1.1,0,0,-18.7,0.1,0.2,0\n"
+                                     "0,1,0,0,0,0,18.7,0.1,0.2,0\n";
+  const std::string out = " --out " + path("load.json");
+  expect_error(run("payload --static --gravity '0 0 0' --data " + path("quat.csv") + out), 1,
+               "gravity");
+  expect_error(run("payload --static --data " + path("quat.csv") + out), 1, "row 2");
+  std::ofstream(path("two.csv")) << "qx,qy,qz,qw,fx,fy,fz,mx,my,mz\n"
+                                    "0,0,0,1,0,0,-18.7,0.1,0.2,0\n"
+                                    "0,1,0,0,0,0,18.7,0.1,0.2,0\n";
+  expect_error(run("payload --static --bias --data " + path("two.csv") + out), 1, "at least 3");
+  std::ofstream same(path("same.csv"));
+  same << "qx,qy,qz,qw,fx,fy,fz,mx,my,mz\n";
+  for (int k = 0; k < 6; ++k) same << "0,0,0,1,0,0,-18.7," << 0.1 + 0.001 * k << ",0.2,0\n";
+  same.close();
+  expect_error(run("payload --static --data " + path("same.csv") + out), 1, "all the same");
+  std::ofstream empty(path("empty.csv"));
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  empty << "qx,qy,qz,qw,fx,fy,fz,mx,my,mz\n";
+  const char* quats[] = {"0,0,0,1", "1,0,0,0", "0,1,0,0",
+                         "0,0.7071067811865476,0,0.7071067811865476"};
+  for (int k = 0; k < 8; ++k) {
+    empty << quats[k % 4];
+    for (int c = 0; c < 6; ++c) empty << ',' << noise(rng);
+    empty << '\n';
+  }
+  empty.close();
+  expect_error(run("payload --static --data " + path("empty.csv") + out), 1, "no load");
+  expect_error(run("payload --data " + path("run.csv") + out), 1, "qx qy qz qw");
+  expect_error(run(robot + path("run.csv") + " --model energy"), 2, "--model");
+  expect_error(run(robot + path("run.csv") + " --history " + path("h.csv")), 2, "rls");
+}
+
+}  // namespace
+}  // namespace dynid
