@@ -191,8 +191,8 @@ TEST(IdentifyCli, ValidateUsesTheIdentificationCutoff) {
   const std::string stored = load(out)["choices"]["cutoff_hz"].get<std::string>();
   const std::string data = planar2_positions(1e-3);
   const std::string val = ::testing::TempDir() + "/planar2_cutoff_val.json";
-  const std::string validate = "validate --robot planar2 --params " + out + " --data " + data +
-                               " --json " + val;
+  const std::string validate =
+      "validate --robot planar2 --params " + out + " --data " + data + " --json " + val;
   r = run(validate);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(load(val)["choices"]["cutoff_hz"].get<std::string>(), stored);
