@@ -1,12 +1,20 @@
-// `dynid excite`: optimise a Fourier excitation and write the reference trajectory.
+// `dynid excite`: optimise a Fourier excitation, or build a one-joint experiment reference (slope,
+// bang-bang, trapezoid, spline), and write the reference trajectory.
 #include <cmath>
 #include <iostream>
 #include <memory>
+#include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
+#include "dynid/excitation/bang_bang_trajectory.hpp"
 #include "dynid/excitation/fourier_trajectory.hpp"
+#include "dynid/excitation/polynomial_spline.hpp"
+#include "dynid/excitation/slope_trajectory.hpp"
+#include "dynid/excitation/trapezoidal_trajectory.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/report/excitation_report.hpp"
@@ -22,6 +30,11 @@ struct ExciteCliOptions {
   std::vector<double> dq_max, ddq_max, tau_max;
   unsigned seed = 20261123;
   bool no_rest = false;
+  // One-joint experiment references (--family other than fourier).
+  std::string family = "fourier", range;
+  int joint = 0, cycles = 1;
+  double velocity = 0.0, acceleration = 0.0, dwell = 0.0, duration = 0.0;
+  std::vector<double> pose, via;
 };
 
 Eigen::VectorXd limits(const std::vector<double>& v, int n, const char* flag) {
@@ -34,7 +47,167 @@ Eigen::VectorXd limits(const std::vector<double>& v, int n, const char* flag) {
   return Eigen::Map<const Eigen::VectorXd>(v.data(), n);
 }
 
+// "A:B" of --range as two numbers.
+std::pair<double, double> parse_range(const std::string& text) {
+  const auto colon = text.find(':');
+  try {
+    if (colon == std::string::npos) throw std::invalid_argument("no colon");
+    size_t used_a = 0, used_b = 0;
+    const double a = std::stod(text.substr(0, colon), &used_a);
+    const double b = std::stod(text.substr(colon + 1), &used_b);
+    if (used_a != colon || used_b != text.size() - colon - 1 || !std::isfinite(a) ||
+        !std::isfinite(b) || a == b) {
+      throw std::invalid_argument("bad");
+    }
+    return {a, b};
+  } catch (const std::exception&) {
+    throw UsageError("--range '" + text +
+                     "' is not FROM:TO with two different finite positions [rad or m], e.g. "
+                     "-0.5:0.5");
+  }
+}
+
+// The reference of a one-joint experiment: joint o.joint moves, the others stay at --pose; the
+// samples are checked against the model's limits narrowed by --limit-fraction (and the given
+// --velocity-limit / --acceleration-limit).
+TrajectorySamples joint_experiment(const Model& model, const ExciteCliOptions& o) {
+  const int n = model.dof();
+  if (o.joint < 1 || o.joint > n) {
+    throw UsageError("--joint " + std::to_string(o.joint) + " is not a joint of '" + o.robot +
+                     "' (1.." + std::to_string(n) + "); --family " + o.family +
+                     " moves one joint, give its number");
+  }
+  const int j = o.joint - 1;
+  Eigen::VectorXd pose = Eigen::VectorXd::Zero(n);
+  if (!o.pose.empty()) {
+    pose = limits(o.pose, n, "--pose");
+  } else {
+    for (int k = 0; k < n; ++k) {  // 0, or the middle of a range that excludes it
+      const JointLimits& l = model.joints[k].limits;
+      if (!(l.lower <= 0.0 && 0.0 <= l.upper)) pose[k] = 0.5 * (l.lower + l.upper);
+    }
+  }
+  auto at = [&](double qj) {
+    Eigen::VectorXd q = pose;
+    q[j] = qj;
+    return q;
+  };
+  auto need = [&](double value, const char* flag, const char* example) {
+    if (!(value > 0.0)) {
+      throw UsageError("--family " + o.family + " needs " + flag + " > 0 (e.g. " + example + ")");
+    }
+  };
+  const Eigen::VectorXd same = Eigen::VectorXd::Constant(n, 1.0);
+  std::unique_ptr<Trajectory> trajectory;
+  if (o.family == "spline") {
+    if (o.via.size() < 2) {
+      throw UsageError("--family spline needs --via with at least 2 positions of joint " +
+                       std::to_string(o.joint) + " (e.g. --via 0,0.8,-0.4,0)");
+    }
+    need(o.duration, "--duration [s]", "--duration 4");
+    const auto m = static_cast<Eigen::Index>(o.via.size());
+    Eigen::MatrixXd points(n, m);
+    for (Eigen::Index k = 0; k < m; ++k) points.col(k) = at(o.via[static_cast<size_t>(k)]);
+    trajectory =
+        std::make_unique<PolynomialSpline>(Eigen::VectorXd::LinSpaced(m, 0.0, o.duration), points);
+  } else {
+    if (o.range.empty()) {
+      throw UsageError("--family " + o.family + " needs --range FROM:TO of joint " +
+                       std::to_string(o.joint) + " (e.g. --range -0.5:0.5)");
+    }
+    if (o.cycles < 1) throw UsageError("--cycles must be >= 1");
+    if (!(o.dwell >= 0.0)) throw UsageError("--dwell must be >= 0 s");
+    const auto [from, to] = parse_range(o.range);
+    need(o.acceleration, "--acceleration [rad/s²]", "--acceleration 2");
+    const Eigen::VectorXd a = o.acceleration * same;
+    if (o.family == "slope") {
+      need(o.velocity, "--velocity [rad/s]", "--velocity 0.3");
+      trajectory = std::make_unique<SlopeTrajectory>(at(from), at(to), o.velocity * same, a,
+                                                     o.cycles, o.dwell);
+    } else {
+      Eigen::MatrixXd way(n, 2 * o.cycles + 1);
+      for (int k = 0; k <= 2 * o.cycles; ++k) way.col(k) = at(k % 2 ? to : from);
+      if (o.family == "trapezoid") {
+        need(o.velocity, "--velocity [rad/s]", "--velocity 0.3");
+        trajectory = std::make_unique<TrapezoidalTrajectory>(way, o.velocity * same, a, o.dwell);
+      } else {
+        trajectory = std::make_unique<BangBangTrajectory>(way, a, o.dwell);
+      }
+    }
+  }
+  TrajectorySamples samples = sample_trajectory(*trajectory, o.rate, true);
+  // Limits with the --limit-fraction margin: positions within the central fraction of the range.
+  const Eigen::VectorXd dq_max = limits(o.dq_max, n, "--velocity-limit");
+  const Eigen::VectorXd ddq_max = limits(o.ddq_max, n, "--acceleration-limit");
+  for (int k = 0; k < n; ++k) {
+    const JointLimits& l = model.joints[k].limits;
+    const std::string name = "joint " + std::to_string(k + 1) + " (" + model.joints[k].name + ")";
+    const double mid = 0.5 * (l.lower + l.upper),
+                 half = 0.5 * o.limit_fraction * (l.upper - l.lower);
+    const double lo = std::isfinite(half) ? mid - half : l.lower;
+    const double hi = std::isfinite(half) ? mid + half : l.upper;
+    const double q_lo = samples.q.col(k).minCoeff(), q_hi = samples.q.col(k).maxCoeff();
+    if (q_lo < lo || q_hi > hi) {
+      throw UsageError(name + " reaches [" + short_number(q_lo) + ", " + short_number(q_hi) +
+                       "] outside its allowed range [" + short_number(lo) + ", " +
+                       short_number(hi) + "] (model limits x --limit-fraction " +
+                       short_number(o.limit_fraction) + "); change --range/--via or --pose");
+    }
+    double v_lim = o.limit_fraction * l.velocity;
+    if (dq_max.size()) v_lim = std::min(v_lim, dq_max[k]);
+    const double v = samples.dq.col(k).cwiseAbs().maxCoeff();
+    if (v > v_lim) {
+      throw UsageError(name + " reaches " + short_number(v) + " rad/s, above its limit " +
+                       short_number(v_lim) + "; lower --velocity or lengthen --duration");
+    }
+    if (ddq_max.size()) {
+      const double acc = samples.ddq.col(k).cwiseAbs().maxCoeff();
+      if (acc > ddq_max[k]) {
+        throw UsageError(name + " reaches " + short_number(acc) +
+                         " rad/s², above --acceleration-limit " + short_number(ddq_max[k]) +
+                         "; lower --acceleration or lengthen --duration");
+      }
+    }
+  }
+  return samples;
+}
+
+void run_joint_experiment(const ExciteCliOptions& o) {
+  if (!(o.rate > 0.0)) throw UsageError("--rate must be > 0 Hz");
+  if (!(o.limit_fraction > 0.0 && o.limit_fraction <= 1.0)) {
+    throw UsageError("--limit-fraction must be in (0, 1]");
+  }
+  const Model model = load_robot(o.robot);
+  TrajectorySamples samples;
+  try {
+    samples = joint_experiment(model, o);
+  } catch (const UsageError&) {
+    throw;
+  } catch (const Error& e) {  // the trajectory's own checks (too short a range for the speed)
+    throw UsageError("--family " + o.family + ": " + e.what());
+  }
+  write_trajectory_csv(o.out, samples);
+  std::cout << o.family << " reference of joint " << o.joint << ": " << samples.t.size()
+            << " samples over " << short_number(samples.t[samples.t.size() - 1]) << " s\n"
+            << "wrote " << o.out << '\n';
+}
+
 void run_excite(const ExciteCliOptions& o) {
+  if (o.family != "fourier") {
+    if (o.family != "slope" && o.family != "bang-bang" && o.family != "trapezoid" &&
+        o.family != "spline") {
+      throw UsageError("--family must be fourier, slope, bang-bang, trapezoid or spline, not '" +
+                       o.family + "'");
+    }
+    if (!o.json.empty()) throw UsageError("--json is written by --family fourier only");
+    run_joint_experiment(o);
+    return;
+  }
+  if (o.joint != 0) {
+    throw UsageError(
+        "--joint with --family fourier (one joint at a time) is not available yet; omit --joint "
+        "to optimise every joint together");
+  }
   if (o.criterion != "cond" && o.criterion != "logdet") {
     throw UsageError("--criterion must be cond or logdet, not '" + o.criterion + "'");
   }
@@ -114,6 +287,26 @@ void add_excite_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--no-rest", o->no_rest,
                 "Do not force zero velocity/acceleration at start and end");
+  cmd->add_option("--family", o->family,
+                  "fourier (optimised, every joint), or a one-joint experiment reference: slope "
+                  "(constant-velocity slopes, gravity), bang-bang (friction), trapezoid, spline")
+      ->capture_default_str();
+  cmd->add_option("--joint", o->joint, "The joint that moves (1..n); the others stay at --pose");
+  cmd->add_option("--pose", o->pose,
+                  "Positions of the other joints [rad or m], n values; default 0 (or the middle "
+                  "of a range that excludes 0)")
+      ->delimiter(',');
+  cmd->add_option("--range", o->range, "slope, bang-bang, trapezoid: FROM:TO of the joint");
+  cmd->add_option("--velocity", o->velocity, "slope, trapezoid: cruise speed [rad/s]");
+  cmd->add_option("--acceleration", o->acceleration,
+                  "slope, bang-bang, trapezoid: acceleration [rad/s²]");
+  cmd->add_option("--cycles", o->cycles, "slope, bang-bang, trapezoid: FROM-TO-FROM cycles")
+      ->capture_default_str();
+  cmd->add_option("--dwell", o->dwell, "Rest between moves [s]")->capture_default_str();
+  cmd->add_option("--via", o->via,
+                  "spline: positions of the joint, equally spaced in time, at rest at both ends")
+      ->delimiter(',');
+  cmd->add_option("--duration", o->duration, "spline: duration [s]");
   cmd->callback([o] { run_excite(*o); });
 }
 

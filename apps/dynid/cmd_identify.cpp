@@ -230,9 +230,9 @@ void add_signal_flags(CLI::App* cmd, IdentifyCliOptions& o) {
          "Closed-loop rigid model identification of an industrial robot, 2005)")
       ->capture_default_str();
   cmd->add_option("--cutoff", o.cutoff,
-                  "Filter cut-off [Hz], or auto (= 0, default): 1.5 x the highest frequency where "
-                  "the position spectrum stands 20 dB above its noise floor, in [1 Hz, min(20 Hz, "
-                  "rate/10)]")
+                  "Filter cut-off [Hz], or auto (= 0, default): the best torque prediction on "
+                  "held-out blocks among cut-offs from 1.5 x the highest frequency where the "
+                  "position spectrum stands 20 dB above its noise floor up to min(20 Hz, rate/10)")
       ->transform(CLI::Transformer(std::map<std::string, std::string>{{"auto", "0"}}));
   cmd->add_option("--decimate", o.decimate,
                   "Keep every N-th sample after filtering; 0 = rate/(10·cut-off)");
@@ -334,6 +334,7 @@ struct ValidateCliOptions {
   std::vector<double> zero_velocity;
   std::vector<double> torque_scale;
   std::string rows, time;
+  double cutoff = 0.0;
 };
 
 void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
@@ -377,7 +378,15 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
   o.friction = file_options.get("friction", o.friction);
   o.no_armature = !file_options.get("armature", true);
   o.filter = file_options.get("filter", o.filter);
-  o.cutoff = file_options.get("cutoff_hz", 0.0);
+  // The cut-off identify used (its automatic choice included), not one chosen again on this run.
+  if (cmd.count("--cutoff")) {
+    o.cutoff = v.cutoff;
+  } else if (identified.cutoff_hz > 0.0) {
+    o.cutoff = identified.cutoff_hz;
+    read.notes.push_back("cut-off as identify used it (stored in '" + v.params + "')");
+  } else {
+    o.cutoff = file_options.get("cutoff_hz", 0.0);
+  }
   o.savgol = file_options.get("savitzky_golay", false);
   o.torque_offset = file_options.get("torque_offset_s", 0.0);
   o.filter_coulomb = file_options.get("filter_coulomb_columns", false);
@@ -512,6 +521,10 @@ void add_validate_command(CLI::App& app) {
       ->description(
           "tau_j = K_j * logged torque column (e.g. drive gain x current): one value or one per "
           "joint, comma separated; default: the scale given to identify (stored in --params)");
+  cmd->add_option("--cutoff", v->cutoff,
+                  "Filter cut-off [Hz] for this run; default: the cut-off identify used (stored "
+                  "in --params); auto (= 0) chooses again from this run")
+      ->transform(CLI::Transformer(std::map<std::string, std::string>{{"auto", "0"}}));
   cmd->add_option("--zero-velocity", v->zero_velocity,
                   "Rows of joint j with |dq_j| below this [rad/s] are left out of the second "
                   "(near-still-free) error figure (1 or n values); default: the thresholds "

@@ -24,6 +24,7 @@ const SignRule kSignRules[] = {
     {"identify", "--rate", Sign::kNonNegative},
     {"identify", "--zero-velocity", Sign::kNonNegative},
     {"identify", "--threads", Sign::kNonNegative},
+    {"validate", "--cutoff", Sign::kNonNegative},
     {"validate", "--rate", Sign::kNonNegative},
     {"validate", "--zero-velocity", Sign::kNonNegative},
     {"excite", "--harmonics", Sign::kPositive},

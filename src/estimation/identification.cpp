@@ -7,6 +7,7 @@
 #include <Eigen/SVD>
 
 #include "dynid/common/error.hpp"
+#include "dynid/estimation/cutoff_selection.hpp"
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/outliers.hpp"
 #include "dynid/estimation/recursive_least_squares.hpp"
@@ -355,7 +356,9 @@ IdentificationResult identify(const Model& model, const JointRecord& record,
   const int n = model.dof();
   IdentificationResult result;
   const ScreenedRun screened = screen_run(model, record, options.outliers);  // outliers.hpp
-  result.processed = preprocess_run(model, screened.record, options.signal, result.choices);
+  const CutoffSelection cutoff = select_cutoff(model, screened.record, options);
+  result.processed = preprocess_run(model, screened.record, cutoff.signal, result.choices);
+  echo_cutoff_selection(cutoff, result.choices);
   const JointRecord& r = result.processed.record;
   const Eigen::Index m = r.t.size();
   result.samples = m;

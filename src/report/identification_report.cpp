@@ -182,6 +182,20 @@ IdentifiedResultFile read_identification_result(const std::string& path) {
       out.zero_velocity_threshold.push_back(x.get<double>());
     }
   }
+  const auto choices = j.find("choices");
+  if (choices != j.end() && choices->is_object() && choices->contains("cutoff_hz")) {
+    const auto& c = (*choices)["cutoff_hz"];
+    try {
+      out.cutoff_hz = c.is_number() ? c.get<double>() : std::stod(c.get<std::string>());
+    } catch (const std::exception&) {
+      out.cutoff_hz = -1.0;
+    }
+    if (!(out.cutoff_hz > 0.0) || !std::isfinite(out.cutoff_hz)) {
+      throw Error("'" + path +
+                  "': choices.cutoff_hz must be a positive number of Hz; write the file with "
+                  "dynid identify");
+    }
+  }
   return out;
 }
 

@@ -4,6 +4,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
+#include <random>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -153,6 +156,57 @@ TEST(IdentifyCli, ValidateRebuildsTheDefaultCoulombColumnsOfIdentify) {
   EXPECT_EQ(v["rows"].get<long>(), id["rows"].get<long>());
   EXPECT_NEAR(v["relative_error"].get<double>(), id["relative_error"].get<double>(),
               1e-9 * id["relative_error"].get<double>());
+}
+
+// A copy of planar2_run() with only t, q and tau, q with white noise of std `noise` (fixed seed).
+std::string planar2_positions(double noise) {
+  const std::string path = ::testing::TempDir() + "/planar2_positions_" +
+                           std::to_string(static_cast<int>(noise * 1e6)) + ".csv";
+  std::ifstream in(planar2_run(0.8));
+  std::ofstream out(path);
+  std::string line;
+  std::getline(in, line);
+  out << "t,q1,q2,tau1,tau2\n";
+  std::mt19937 rng(5);
+  std::normal_distribution<double> gauss(0.0, noise);
+  while (std::getline(in, line)) {
+    double v[9];
+    char comma;
+    std::istringstream row(line);
+    row >> v[0];
+    for (int i = 1; i < 9; ++i) row >> comma >> v[i];
+    out << std::setprecision(17) << v[0] << ',' << v[1] + gauss(rng) << ',' << v[2] + gauss(rng)
+        << ',' << v[7] << ',' << v[8] << '\n';
+  }
+  return path;
+}
+
+// validate filters the run with the cut-off identify used (choices.cutoff_hz of the result), not
+// one chosen again from the validation run, unless --cutoff is given (auto chooses again). The
+// noisy validation run makes the two differ: chosen again, its cut-off is lower.
+TEST(IdentifyCli, ValidateUsesTheIdentificationCutoff) {
+  const std::string out = ::testing::TempDir() + "/planar2_cutoff.json";
+  CliRun r = run("identify --robot planar2 --data " + planar2_positions(0.0) + " --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string stored = load(out)["choices"]["cutoff_hz"].get<std::string>();
+  const std::string data = planar2_positions(1e-3);
+  const std::string val = ::testing::TempDir() + "/planar2_cutoff_val.json";
+  const std::string validate =
+      "validate --robot planar2 --params " + out + " --data " + data + " --json " + val;
+  r = run(validate);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(load(val)["choices"]["cutoff_hz"].get<std::string>(), stored);
+  EXPECT_NE((r.out + r.err).find("cut-off as identify used it"), std::string::npos) << r.err;
+  r = run(validate + " --cutoff auto");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const double again = std::stod(load(val)["choices"]["cutoff_hz"].get<std::string>());
+  EXPECT_LT(again, 0.8 * std::stod(stored));
+  r = run(validate + " --cutoff 3");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(load(val)["choices"]["cutoff_hz"].get<std::string>(), "3");
+  r = run(validate + " --cutoff -1");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << r.err;
 }
 
 TEST(IdentifyCli, BadInputsGiveOneErrorLineAndNoOutput) {

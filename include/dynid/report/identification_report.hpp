@@ -33,6 +33,9 @@ struct IdentifiedResultFile {
   /// `zero_velocity_threshold` per joint as identify used it; empty in files written before it
   /// was stored.
   std::vector<double> zero_velocity_threshold;
+  /// `choices.cutoff_hz`, the low-pass cut-off identify used [Hz]; 0 when absent (no filter, or
+  /// a file written before it was stored).
+  double cutoff_hz = 0.0;
 };
 
 /// Reads a result JSON (identification_to_json). Throws dynid::Error naming the file when
