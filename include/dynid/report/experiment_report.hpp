@@ -1,0 +1,34 @@
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "dynid/estimation/decoupled_model.hpp"
+#include "dynid/estimation/friction_experiment.hpp"
+#include "dynid/estimation/gravity_experiment.hpp"
+#include "dynid/model/model.hpp"
+
+namespace dynid {
+
+/// Result JSON of `dynid identify --model gravity` (seed 2 Table 1): `parameters` k<J>, qoff<J>
+/// (name, value, std, relative_std_percent, ci_low, ci_high) as identify writes them, plus
+/// `slopes` (name, velocity, offset, offset_std, rows), `fit` (the cruise samples: run, q, tau,
+/// fitted) for plotting, `choices`, `warnings`, `options` and the version.
+nlohmann::json gravity_experiment_to_json(const Model& model, const GravityExperimentResult& r,
+                                          const nlohmann::json& options_used);
+
+/// Result JSON of `dynid identify --model friction` (seed 2 Table 2): `parameters` Fvp<J> Fvn<J>
+/// Fcp<J> Fcn<J>, `curve` (velocity, torque) and `fit` (run, t, dq, tau, fitted) for plotting.
+nlohmann::json friction_experiment_to_json(const Model& model, const FrictionExperimentResult& r,
+                                           const nlohmann::json& options_used);
+
+/// Result JSON of `dynid identify --model decoupled` (seed 2 eqs. 21–22): `parameters` M<J>,
+/// k<J>, qoff<J>, Fvp<J> Fvn<J> Fcp<J> Fcn<J>, `held_span` and `coupling_ratio` per joint.
+nlohmann::json decoupled_model_to_json(const Model& model, const DecoupledJointResult& r,
+                                       const nlohmann::json& options_used);
+
+/// The `parameters` of one of these JSON results as a table for the terminal, with its warnings.
+std::string experiment_table(const nlohmann::json& result);
+
+}  // namespace dynid

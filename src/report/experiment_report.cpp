@@ -1,0 +1,167 @@
+#include "dynid/report/experiment_report.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "dynid/common/message.hpp"
+#include "dynid/io/json_writer.hpp"
+#include "dynid/version.hpp"
+
+namespace dynid {
+
+namespace {
+
+nlohmann::json numbers(const Eigen::VectorXd& v) {
+  nlohmann::json a = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(json_number(v[i]));
+  return a;
+}
+
+nlohmann::json parameter(const std::string& name, double value, double std, double critical) {
+  return {{"name", name},
+          {"value", json_number(value)},
+          {"std", json_number(std)},
+          {"relative_std_percent",
+           json_number(value != 0.0 ? 100.0 * std / std::abs(value) : INFINITY)},
+          {"ci_low", json_number(value - critical * std)},
+          {"ci_high", json_number(value + critical * std)}};
+}
+
+// Parameters i of an estimate, with their intervals as the estimator computed them.
+void add_estimated(nlohmann::json& params, const std::vector<std::string>& names, const Estimate& e,
+                   Eigen::Index from, Eigen::Index to) {
+  for (Eigen::Index i = from; i < to; ++i) {
+    params.push_back({{"name", names[static_cast<size_t>(i)]},
+                      {"value", json_number(e.x[i])},
+                      {"std", json_number(e.std_dev[i])},
+                      {"relative_std_percent", json_number(e.relative_std_percent[i])},
+                      {"ci_low", json_number(e.ci_lower[i])},
+                      {"ci_high", json_number(e.ci_upper[i])}});
+    if (e.std_dev_white.size() == e.x.size())
+      params.back()["std_white"] = json_number(e.std_dev_white[i]);
+  }
+}
+
+nlohmann::json common(const Model& model, const char* kind, int joint, nlohmann::json params,
+                      const Estimate& e,
+                      const std::vector<std::pair<std::string, std::string>>& choices,
+                      const std::vector<std::string>& warnings, const nlohmann::json& options) {
+  nlohmann::json c = nlohmann::json::object();
+  for (const auto& [k, v] : choices) c[k] = v;
+  c["model"] = kind;
+  std::vector<std::string> joints;
+  for (const Joint& j : model.joints) joints.push_back(j.name);
+  return {
+      {"model",
+       {{"name", model.name}, {"source", model.source}, {"dof", model.dof()}, {"joints", joints}}},
+      {"experiment", kind},
+      {"joint", joint + 1},
+      {"parameters", std::move(params)},
+      {"confidence_level", e.confidence_level},
+      {"estimator", to_string(e.summary.estimator)},
+      {"warnings", warnings},
+      {"choices", c},
+      {"options", options},
+      {"version", kVersion}};
+}
+
+// Half-width multiplier of the estimate's intervals (the HAC fixed-b value).
+double critical(const Estimate& e) {
+  return e.critical_value > 0.0 ? e.critical_value : e.t_quantile;
+}
+
+}  // namespace
+
+nlohmann::json gravity_experiment_to_json(const Model& model, const GravityExperimentResult& r,
+                                          const nlohmann::json& options_used) {
+  const std::string j = std::to_string(r.joint + 1);
+  const double c = critical(r.estimate);
+  nlohmann::json params = nlohmann::json::array();
+  params.push_back(parameter("k" + j, r.k, r.k_std, c));
+  params.push_back(parameter("qoff" + j, r.q_off, r.q_off_std, c));
+  nlohmann::json out = common(model, "gravity", r.joint, std::move(params), r.estimate, r.choices,
+                              r.warnings, options_used);
+  nlohmann::json slopes = nlohmann::json::array();
+  for (size_t s = 0; s < r.slope_names.size(); ++s) {
+    slopes.push_back({{"name", r.slope_names[s]},
+                      {"velocity", json_number(r.slope_velocity[s])},
+                      {"offset", json_number(r.offset[s])},
+                      {"offset_std", json_number(r.offset_std[s])},
+                      {"rows", r.slope_rows[s]}});
+  }
+  out["slopes"] = slopes;
+  out["rows"] = r.rows;
+  out["relative_error"] = json_number(r.relative_error);
+  out["residual_rms"] = json_number(r.residual_rms);
+  out["fit"] = {{"run", r.sample_run},
+                {"q", numbers(r.sample_q)},
+                {"tau", numbers(r.sample_tau)},
+                {"fitted", numbers(r.sample_fitted)}};
+  return out;
+}
+
+nlohmann::json friction_experiment_to_json(const Model& model, const FrictionExperimentResult& r,
+                                           const nlohmann::json& options_used) {
+  nlohmann::json params = nlohmann::json::array();
+  add_estimated(params, r.names, r.estimate, 0, 4);
+  nlohmann::json out = common(model, "friction", r.joint, std::move(params), r.estimate, r.choices,
+                              r.warnings, options_used);
+  out["rows"] = r.rows;
+  out["rows_left_out"] = r.rows_left_out;
+  out["zero_velocity_threshold"] = json_number(r.zero_velocity_threshold);
+  out["relative_error"] = json_number(r.relative_error);
+  out["residual_rms"] = json_number(r.residual_rms);
+  out["curve"] = {{"velocity", numbers(r.curve_velocity)}, {"torque", numbers(r.curve_torque)}};
+  out["fit"] = {{"run", r.sample_run},
+                {"t", numbers(r.sample_t)},
+                {"dq", numbers(r.sample_dq)},
+                {"tau", numbers(r.sample_tau)},
+                {"fitted", numbers(r.sample_fitted)}};
+  return out;
+}
+
+nlohmann::json decoupled_model_to_json(const Model& model, const DecoupledJointResult& r,
+                                       const nlohmann::json& options_used) {
+  const std::string j = std::to_string(r.joint + 1);
+  const double c = critical(r.estimate);
+  nlohmann::json params = nlohmann::json::array();
+  add_estimated(params, r.names, r.estimate, 0, 1);
+  params.push_back(parameter("k" + j, r.k, r.k_std, c));
+  params.push_back(parameter("qoff" + j, r.q_off, r.q_off_std, c));
+  add_estimated(params, r.names, r.estimate, 3, 7);
+  nlohmann::json out = common(model, "decoupled", r.joint, std::move(params), r.estimate, r.choices,
+                              r.warnings, options_used);
+  out["rows"] = r.rows;
+  out["relative_error"] = json_number(r.relative_error);
+  out["held_span"] = numbers(r.held_span);
+  out["coupling_ratio"] = numbers(r.coupling_ratio);
+  return out;
+}
+
+std::string experiment_table(const nlohmann::json& result) {
+  std::ostringstream s;
+  char buf[256];
+  std::snprintf(buf, sizeof(buf), "%-10s %14s %12s %9s   %.4g%% confidence interval\n", "parameter",
+                "value", "std", "%std", 100.0 * result.value("confidence_level", 0.0));
+  s << buf;
+  auto num = [](const nlohmann::json& v) { return v.is_number() ? v.get<double>() : NAN; };
+  for (const auto& p : result["parameters"]) {
+    std::snprintf(buf, sizeof(buf), "%-10s %14.6g %12.4g %9.2f   [%.6g, %.6g]\n",
+                  p["name"].get<std::string>().c_str(), num(p["value"]), num(p["std"]),
+                  num(p["relative_std_percent"]), num(p["ci_low"]), num(p["ci_high"]));
+    s << buf;
+  }
+  if (result.contains("relative_error")) {
+    std::snprintf(buf, sizeof(buf),
+                  "\n%s experiment of joint %d: %ld samples, relative error %.2f %%\n",
+                  result["experiment"].get<std::string>().c_str(), result["joint"].get<int>(),
+                  result.value("rows", 0L), 100.0 * num(result["relative_error"]));
+    s << buf;
+  }
+  for (const auto& w : result["warnings"])
+    s << "warning: " << one_line(w.get<std::string>()) << '\n';
+  return s.str();
+}
+
+}  // namespace dynid
