@@ -356,6 +356,40 @@ int column_joint(const Model& model, const ParameterLayout& layout, int column) 
   return -1;
 }
 
+// A joint whose processed velocity never leaves its noise band did not move: the controller held
+// it and the encoder noise made it jitter. Its velocity, acceleration and Coulomb indicators are
+// set to zero so that no velocity-driven column (Ia, Fv, Fc, coupled motors) looks excited by
+// noise; its position (gravity) is kept. |dq| of pure Gaussian noise passes 6 σ_dq with
+// probability 2e-9 per sample, so a run of 10⁶ samples still classifies a still joint as still.
+constexpr double kStillNoiseMultiple = 6.0;
+
+void hold_still_joints(const Model& model, ProcessedRecord& p,
+                       std::vector<std::pair<std::string, std::string>>& choices) {
+  JointRecord& r = p.record;
+  std::string still;
+  for (Eigen::Index j = 0; j < r.dq.cols(); ++j) {
+    const double sigma = j < p.velocity_noise_std.size() ? p.velocity_noise_std[j] : 0.0;
+    const double peak = r.dq.col(j).cwiseAbs().maxCoeff();
+    if (!(sigma > 0.0) || peak >= kStillNoiseMultiple * sigma) continue;
+    r.dq.col(j).setZero();
+    r.ddq.col(j).setZero();
+    if (p.moving_positive.size()) {
+      p.moving_positive.col(j).setZero();
+      p.moving_negative.col(j).setZero();
+    }
+    std::ostringstream w;
+    w << std::setprecision(3) << model.joints[static_cast<size_t>(j)].name << " (max|dq| " << peak
+      << " < " << kStillNoiseMultiple << " x noise std " << sigma << ")";
+    still += (still.empty() ? "" : ", ") + w.str();
+  }
+  if (!still.empty()) {
+    choices.emplace_back("still_joints",
+                         still +
+                             ": held still, their motion is encoder noise; velocity and "
+                             "acceleration taken as zero");
+  }
+}
+
 // One warning per base parameter the data leave undetermined: why, and which motion would excite
 // it where that is cheap to say (its own joint, or the parameters it cannot be told from).
 void not_excited_warnings(const Model& model, const ParameterLayout& layout,
@@ -415,6 +449,7 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
     screened.push_back(screen_run(model, runs[i], options.outliers));  // outliers.hpp
     ProcessedRecord processed =
         preprocess_run(model, screened.back().record, options.signal, choices);
+    hold_still_joints(model, processed, choices);
     const Eigen::VectorXd threshold =
         zero_velocity_threshold(options, processed, "removed", choices);
     blocks.push_back(differential_equations(model, options.layout, coupling, processed, threshold));
@@ -439,7 +474,7 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
   result.base = compute_base_parameters(model, base_options);
   result.unidentifiable = result.base.unidentifiable_names();
   result.rank = result.base.rank;
-  const EquationBlock based = select_base_columns(stack_equations(blocks), result.base);
+  EquationBlock based = select_base_columns(stack_equations(blocks), result.base);
   result.rows = based.y.size();
   // Data-identifiable columns: what these data determine of the base set.
   const DataIdentifiability data = data_identifiability(based);
@@ -463,6 +498,19 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
   for (int c : data.not_excited) {
     result.not_excited.push_back(result.base.names[static_cast<size_t>(c)]);
   }
+  result.data_regrouping =
+      Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(data.kept.size()),
+                            static_cast<Eigen::Index>(data.not_excited.size()));
+  for (size_t i = 0; i < data.kept.size(); ++i) {
+    for (const auto& [col, coef] : data.absorbs[i]) {
+      const auto at = std::find(data.not_excited.begin(), data.not_excited.end(), col);
+      result.data_regrouping(static_cast<Eigen::Index>(i), at - data.not_excited.begin()) = coef;
+      std::ostringstream term;
+      term << std::setprecision(6) << (coef < 0 ? " - " : " + ") << std::abs(coef) << '*'
+           << result.base.names[static_cast<size_t>(col)] << " (on these data)";
+      result.expressions[i] += term.str();
+    }
+  }
   if (deficient)
     not_excited_warnings(model, options.layout, result.base, based, data, result.warnings);
   // estimate
@@ -472,6 +520,17 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
   eo.hac_bandwidth = options.hac_bandwidth;
   eo.record_history = options.record_history;
   BlockEstimate fit = estimate_block(W, eo);
+  if (blocks.size() > 1 && fit.hac.bandwidth > 0) {
+    // Restack with runs a window apart and that window fixed, so that the HAC sums never pair two
+    // runs' errors (the estimate itself does not depend on the spacing).
+    eo.hac_bandwidth = fit.hac.bandwidth;
+    EquationBlock spaced = based;
+    spaced.sample =
+        select_base_columns(stack_equations(blocks, fit.hac.bandwidth + 1), result.base).sample;
+    if (deficient) spaced = select_columns(spaced, data.kept);
+    fit = estimate_block(spaced, eo);
+    fit.covariance_choice += "; runs stacked a window apart (no window spans two runs)";
+  }
   check_finite_estimate(fit.estimate, screened.front());
   result.estimate = std::move(fit.estimate);
   result.residual_rms = fit.group_rms;

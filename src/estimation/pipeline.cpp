@@ -84,7 +84,7 @@ EquationBlock moving_rows(const EquationBlock& block, const Eigen::MatrixXd& dq,
   return out;
 }
 
-EquationBlock stack_equations(const std::vector<EquationBlock>& blocks) {
+EquationBlock stack_equations(const std::vector<EquationBlock>& blocks, int gap) {
   if (blocks.empty()) throw Error("stack_equations: no blocks");
   if (blocks.size() == 1) return blocks.front();
   Eigen::Index rows = 0;
@@ -98,8 +98,7 @@ EquationBlock stack_equations(const std::vector<EquationBlock>& blocks) {
     rows += b.y.size();
     if (b.sample.size()) span += static_cast<long long>(b.sample.maxCoeff()) + 1;
   }
-  // A gap of span + 1 empty samples between runs: no HAC window reaches across it.
-  const long long gap = span + 1;
+  if (gap < 1) throw Error("stack_equations: gap " + std::to_string(gap) + " is not >= 1");
   if (span + gap * static_cast<long long>(blocks.size()) > std::numeric_limits<int>::max()) {
     throw Error("stack_equations: too many samples to index (" + std::to_string(span) + ")");
   }
@@ -225,7 +224,58 @@ DataIdentifiability data_identifiability(const EquationBlock& block,
   return out;
 }
 
+namespace {
+
+BlockEstimate estimate_as_given(const EquationBlock& block, const BlockEstimationOptions& options);
+
+// θ_c = θ̃_c / s_c for the estimate of the column-scaled block W̃ = W·diag(s)⁻¹... with s the column
+// norms: every σ, interval and history entry scales the same way; relative σ does not change.
+void unscale(BlockEstimate& b, const Eigen::VectorXd& s) {
+  Estimate& e = b.estimate;
+  const Eigen::ArrayXd inv = s.array().inverse();
+  e.x.array() *= inv;
+  e.covariance = inv.matrix().asDiagonal() * e.covariance * inv.matrix().asDiagonal();
+  e.std_dev.array() *= inv;
+  e.ci_lower.array() *= inv;
+  e.ci_upper.array() *= inv;
+  if (e.std_dev_white.size()) {
+    e.std_dev_white.array() *= inv;
+    e.ci_lower_white.array() *= inv;
+    e.ci_upper_white.array() *= inv;
+  }
+  if (b.history_x.size()) {
+    b.history_x = b.history_x * inv.matrix().asDiagonal();
+    b.history_std = b.history_std * inv.matrix().asDiagonal();
+  }
+}
+
+}  // namespace
+
 BlockEstimate estimate_block(const EquationBlock& block, const BlockEstimationOptions& options) {
+  BlockEstimate out = estimate_as_given(block, options);
+  const Eigen::Index p = block.W.cols();
+  if (out.estimate.summary.rank >= p) return out;
+  // Numerically rank deficient as given, but the columns may only differ in scale by more than
+  // the estimator's round-off tolerance max(m, p)·ε allows (a 6-joint arm's inertia and friction
+  // columns span 1e10 with many rows): solve the column-scaled problem, which has the same
+  // solution, and scale back. Only then, so that well-scaled problems keep their numbers.
+  const Eigen::VectorXd s = block.W.colwise().norm().transpose();
+  if ((s.array() <= 0.0).any() || !s.allFinite()) return out;
+  EquationBlock scaled = block;
+  scaled.W = block.W * s.cwiseInverse().asDiagonal();
+  BlockEstimate again = estimate_as_given(scaled, options);
+  if (again.estimate.summary.rank <= out.estimate.summary.rank) return out;
+  unscale(again, s);
+  again.residual = block.y - block.W * again.estimate.x;
+  again.covariance_choice +=
+      "; solved on unit-norm columns (the columns' scales differ beyond round-off), condition "
+      "number of the scaled regressor";
+  return again;
+}
+
+namespace {
+
+BlockEstimate estimate_as_given(const EquationBlock& block, const BlockEstimationOptions& options) {
   const Eigen::MatrixXd& W = block.W;
   const Eigen::VectorXd& y = block.y;
   const Eigen::VectorXi& groups = block.group;
@@ -344,6 +394,8 @@ BlockEstimate estimate_block(const EquationBlock& block, const BlockEstimationOp
   out.warnings = out.estimate.summary.warnings;
   return out;
 }
+
+}  // namespace
 
 ExcitationSummary persistent_excitation(const EquationBlock& block, int window) {
   const Eigen::Index m = block.W.rows(), p = block.W.cols();

@@ -156,8 +156,11 @@ struct IdentificationResult {
   /// parameter); names/estimate hold only the data-identifiable ones.
   int data_rank = 0;
   std::vector<std::string> not_excited;  ///< base parameters the data do not determine
-  bool has_excitation = false;           ///< excitation is filled (RLS)
-  ExcitationSummary excitation;          ///< persistent excitation (seed 1 eq. 38)
+  /// names.size() × not_excited.size(): on these data each estimate is its base parameter plus
+  /// data_regrouping·θ(not_excited) (the data cannot separate them); its expression says so.
+  Eigen::MatrixXd data_regrouping;
+  bool has_excitation = false;   ///< excitation is filled (RLS)
+  ExcitationSummary excitation;  ///< persistent excitation (seed 1 eq. 38)
   /// With IdentifyOptions::record_history and RLS: per equation its time [s], the estimate and σ.
   Eigen::VectorXd history_t;
   Eigen::MatrixXd history_x, history_std;

@@ -31,13 +31,12 @@ EquationBlock moving_rows(const EquationBlock& block, const Eigen::MatrixXd& dq,
                           const Eigen::VectorXd& threshold);
 
 /// The stack stage: the rows of several runs' blocks one after the other. Sample indices of block
-/// b are shifted past those of block b−1 by a gap wider than any HAC window can be (Bartlett
-/// window ≤ (samples − 1)/4, so a gap of the total sample span plus one is never bridged for up to
-/// four runs and, with the automatic 2 % window floor, far beyond), so the covariance never pairs
-/// errors of different runs; the lag-1 residual autocorrelation of identify() skips the gap too.
-/// Every block must have the same columns and group names. Throws dynid::Error for no blocks or
-/// mismatched columns / groups.
-EquationBlock stack_equations(const std::vector<EquationBlock>& blocks);
+/// b start `gap` empty samples after the last of block b−1 (gap ≥ 1), so that consecutive-sample
+/// statistics (lag-1 autocorrelation) never pair two runs, and a HAC window of at most gap − 1
+/// lags never does either (identify() restacks with gap = window + 1 once the window is known).
+/// Every block must have the same columns and group names. Throws dynid::Error for no blocks,
+/// gap < 1 or mismatched columns / groups.
+EquationBlock stack_equations(const std::vector<EquationBlock>& blocks, int gap = 1);
 
 /// The base-column selection: the columns of `block` that are base parameters, in `base.base`
 /// order and named base.names (W_b of Gautier–Khalil: W·θ = W_b·θ_b). The block's columns must be
