@@ -400,7 +400,9 @@ BlockEstimate estimate_as_given(const EquationBlock& block, const BlockEstimatio
 ExcitationSummary persistent_excitation(const EquationBlock& block, int window) {
   const Eigen::Index m = block.W.rows(), p = block.W.cols();
   ExcitationSummary out;
-  out.window = window > 0 ? window : static_cast<int>(10 * p);
+  // Default: a tenth of the run (but at least 10 equations per parameter): short enough to say
+  // from when the condition holds, long enough to span a slow excitation's period.
+  out.window = window > 0 ? window : static_cast<int>(std::max<Eigen::Index>(10 * p, m / 10));
   out.holds_from_t = std::numeric_limits<double>::quiet_NaN();
   if (m == 0 || p == 0) return out;
   const Eigen::VectorXd norms = block.W.colwise().norm().transpose();

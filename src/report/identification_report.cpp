@@ -82,13 +82,17 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
                     {"rows", run.rows},
                     {"relative_error", json_number(run.relative_error)}});
   }
-  nlohmann::json excitation = nullptr;
+  // Present only with RLS; no nulls in results (holds is false when the condition never holds).
+  nlohmann::json excitation = nlohmann::json::object();
   if (r.has_excitation) {
     excitation = {{"window", r.excitation.window},
                   {"windows", r.excitation.windows},
                   {"min_eigenvalue", json_number(r.excitation.min_eigenvalue)},
                   {"max_eigenvalue", json_number(r.excitation.max_eigenvalue)},
-                  {"holds_from_t", json_number(r.excitation.holds_from_t)}};
+                  {"holds", std::isfinite(r.excitation.holds_from_t)}};
+    if (std::isfinite(r.excitation.holds_from_t)) {
+      excitation["holds_from_t"] = r.excitation.holds_from_t;
+    }
   }
   return {{"model",
            {{"name", model.name},

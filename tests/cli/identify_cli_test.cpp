@@ -315,6 +315,7 @@ TEST(IdentifyCli, RlsHistoryIsWrittenAndNeedsRls) {
   const auto j = load(out);
   EXPECT_TRUE(j["excitation"].is_object());
   EXPECT_GT(j["excitation"]["min_eigenvalue"].get<double>(), 0.0);
+  EXPECT_TRUE(j["excitation"]["holds"].get<bool>());
   const CliRun bad =
       run("identify --robot planar2 --data " + data + " --history " + history + " --out " + out);
   EXPECT_EQ(bad.code, 2);

@@ -88,7 +88,8 @@ struct IdentifyOptions {
   /// With the RLS estimator: keep the estimate and σ after every equation (history_* of the
   /// result; memory grows with the rows).
   bool record_history = false;
-  /// Persistent-excitation window ρ (equations) of the RLS excitation report; 0 = 10 × parameters.
+  /// Persistent-excitation window ρ (equations) of the RLS excitation report; 0 = max(10 ×
+  /// parameters, equations/10).
   int excitation_window = 0;
 };
 

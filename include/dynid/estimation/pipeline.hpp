@@ -85,7 +85,8 @@ struct BlockEstimationOptions {
   int hac_bandwidth = -1;  ///< Bartlett window in samples; −1 automatic (Andrews)
   /// With RLS: keep the estimate and its σ after every equation (BlockEstimate::history_*).
   bool record_history = false;
-  /// Persistent-excitation window ρ in equations (seed 1 eq. 38); 0 = auto: 10 × columns.
+  /// Persistent-excitation window ρ in equations (seed 1 eq. 38); 0 = auto: max(10 × columns,
+  /// rows/10).
   int excitation_window = 0;
 };
 
@@ -116,7 +117,7 @@ BlockEstimate estimate_block(const EquationBlock& block, const BlockEstimationOp
 /// consecutive equations (stride ρ/2), on the regressor with each column scaled to unit mean
 /// square (so α, β do not mix units); the condition holds in a window when its smallest eigenvalue
 /// exceeds 1e-6 × its largest, and holds_from_t is the end time of the first window from which it
-/// holds in every later window (NaN if never). ρ ≤ 0: 10 × columns.
+/// holds in every later window (NaN if never). ρ ≤ 0: max(10 × columns, rows/10).
 ExcitationSummary persistent_excitation(const EquationBlock& block, int window);
 
 }  // namespace dynid
