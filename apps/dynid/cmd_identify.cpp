@@ -24,6 +24,8 @@ namespace {
 
 struct IdentifyCliOptions {
   std::string robot, data, out, columns;
+  std::vector<std::string> runs;  // --data, repeatable (identify)
+  std::string history;            // --history (identify, rls)
   std::string friction = "viscous,coulomb,offset";
   bool no_armature = false;
   std::string filter = "auto";
@@ -262,11 +264,23 @@ void warn_identify_no_effect(const IdentifyCliOptions& o, const CLI::App& cmd) {
   if (!o.stream && cmd.count("--threads")) warn("--threads has no effect without --stream");
 }
 
-void run_identify(const IdentifyCliOptions& o, const CLI::App& cmd) {
-  const IdentifyOptions options = library_options(o);
+void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
+  o.data = o.runs.empty() ? std::string() : o.runs.front();
+  IdentifyOptions options = library_options(o);
   const RunFileOptions file = run_file_options(o.columns, o.rate, o.torque_scale, o.rows, o.time);
-  require_readable(o.data, "--data");
+  if (!o.history.empty() && options.estimator != IdentificationEstimator::kRls) {
+    throw UsageError("--history needs --estimator rls (the batch estimators have no history)");
+  }
+  if (o.stream && o.runs.size() > 1) {
+    throw UsageError("--stream reads one run; give one --data, or drop --stream to stack runs");
+  }
+  if (o.stream && !o.history.empty()) {
+    throw UsageError("--history needs the in-memory mode (drop --stream)");
+  }
+  options.record_history = !o.history.empty();
+  for (const auto& run : o.runs) require_readable(run, "--data");
   require_output_folder(o.out, "--out");
+  require_output_folder(o.history, "--history");
   if (o.stream &&
       (!o.torque_scale.empty() || !file.window.empty() || columns_by_position(file.columns))) {
     throw UsageError(
@@ -276,17 +290,30 @@ void run_identify(const IdentifyCliOptions& o, const CLI::App& cmd) {
   warn_identify_no_effect(o, cmd);
   const Model model = load_robot(o.robot);
   RunFileReport read;
-  const IdentificationResult result =
-      o.stream ? identify_stream(model, o.data, file, options, {o.threads, true})
-               : identify(model, read_joint_record(o.data, model, file, &read), options);
+  IdentificationResult result;
+  if (o.stream) {
+    result = identify_stream(model, o.data, file, options, {o.threads, true});
+  } else {
+    // Each run read on its own (same column mapping, window and torque scale for every run).
+    std::vector<JointRecord> records;
+    for (const auto& run : o.runs) records.push_back(read_joint_record(run, model, file, &read));
+    result = identify(model, records, options);
+    for (size_t i = 0; i < result.runs.size(); ++i) result.runs[i].file = o.runs[i];
+  }
   echo_choices("identify", read, result.choices);
   std::cout << identification_table(model, result);
   // Record the Coulomb columns identify actually used (the automatic zero-velocity rule turns the
   // filtered expected-sign columns on), so that validate rebuilds the same regressor.
   nlohmann::json used = echo(o);
   used["filter_coulomb_columns"] = result.processed.moving_positive.size() != 0;
+  if (o.runs.size() > 1) used["data_runs"] = o.runs;
+  if (!o.history.empty()) used["history"] = o.history;
   write_json(o.out, identification_to_json(model, result, used));
   std::cout << "wrote " << o.out << '\n';
+  if (!o.history.empty()) {
+    write_rls_history(o.history, result);
+    std::cout << "wrote " << o.history << '\n';
+  }
 }
 
 // The options a result JSON records, read with the file and key named in any error (a wrong type
@@ -467,11 +494,17 @@ void add_identify_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "identify", "Identify base parameters, friction and actuator inertias from a recorded run");
   cmd->add_option("--robot,-r", o->robot, "Built-in robot name or .urdf/.yaml model")->required();
-  cmd->add_option(
-         "--data,-d", o->data,
-         "Run CSV: t (or --rate), q* or qm* (motor side), tau* or taum*, optional dq*, ddq*")
-      ->required();
+  cmd->add_option("--data,-d", o->runs,
+                  "Run CSV: t (or --rate), q* or qm* (motor side), tau* or taum*, optional dq*, "
+                  "ddq*; repeat --data to identify from several runs together (each is "
+                  "processed on its own, their equations are stacked)")
+      ->required()
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_option("--out,-o", o->out, "Result JSON file")->required();
+  cmd->add_option("--history", o->history,
+                  "With --estimator rls: write the estimate after every equation as CSV (t, then "
+                  "NAME and NAME_std per parameter), to watch when each parameter settles");
   cmd->add_option("--estimator", o->estimator, "ols, wls (Gautier two-step) or rls (U-D recursive)")
       ->capture_default_str();
   cmd->add_option("--confidence", o->confidence, "Confidence level of the intervals")

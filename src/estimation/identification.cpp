@@ -10,6 +10,7 @@
 #include "dynid/estimation/cutoff_selection.hpp"
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/outliers.hpp"
+#include "dynid/estimation/pipeline.hpp"
 #include "dynid/estimation/recursive_least_squares.hpp"
 #include "dynid/estimation/statistics.hpp"
 #include "dynid/model/transmission.hpp"
@@ -308,9 +309,6 @@ ProcessedRecord preprocess_run(const Model& model, const JointRecord& record,
   return preprocess(record, options, choices);
 }
 
-// Lag-1 residual autocorrelation above which identify() warns that its intervals are optimistic.
-constexpr double kCorrelatedResidualWarning = 0.5;
-
 // Rows of joint j where |dq_j| is below threshold_j, too small for sign(dq_j) to be meaningful, are
 // left out when the layout has Coulomb friction: given values (1 or n), or by default
 // max(zero_velocity_fraction × max|dq_j|, zero_velocity_noise_multiple × the processed velocity's
@@ -349,154 +347,221 @@ Eigen::VectorXd zero_velocity_threshold(const IdentifyOptions& options,
   return threshold;
 }
 
+// The joint a layout column belongs to: link parameters of link j and joint columns of joint j;
+// −1 for coupled-motor columns.
+int column_joint(const Model& model, const ParameterLayout& layout, int column) {
+  const int n = model.dof();
+  if (column < kLinkParams * n) return column / kLinkParams;
+  const int jc = layout.joint_columns();
+  if (jc > 0 && column < kLinkParams * n + jc * n) return (column - kLinkParams * n) / jc;
+  return -1;
+}
+
+// A joint whose processed velocity never leaves its noise band did not move: the controller held
+// it and the encoder noise made it jitter. Its velocity, acceleration and Coulomb indicators are
+// set to zero so that no velocity-driven column (Ia, Fv, Fc, coupled motors) looks excited by
+// noise; its position (gravity) is kept. |dq| of pure Gaussian noise passes 6 σ_dq with
+// probability 2e-9 per sample, so a run of 10⁶ samples still classifies a still joint as still.
+constexpr double kStillNoiseMultiple = 6.0;
+
+void hold_still_joints(const Model& model, ProcessedRecord& p,
+                       std::vector<std::pair<std::string, std::string>>& choices) {
+  JointRecord& r = p.record;
+  std::string still;
+  for (Eigen::Index j = 0; j < r.dq.cols(); ++j) {
+    const double sigma = j < p.velocity_noise_std.size() ? p.velocity_noise_std[j] : 0.0;
+    const double peak = r.dq.col(j).cwiseAbs().maxCoeff();
+    if (!(sigma > 0.0) || peak >= kStillNoiseMultiple * sigma) continue;
+    r.dq.col(j).setZero();
+    r.ddq.col(j).setZero();
+    if (p.moving_positive.size()) {
+      p.moving_positive.col(j).setZero();
+      p.moving_negative.col(j).setZero();
+    }
+    std::ostringstream w;
+    w << std::setprecision(3) << model.joints[static_cast<size_t>(j)].name << " (max|dq| " << peak
+      << " < " << kStillNoiseMultiple << " x noise std " << sigma << ")";
+    still += (still.empty() ? "" : ", ") + w.str();
+  }
+  if (!still.empty()) {
+    choices.emplace_back("still_joints",
+                         still +
+                             ": held still, their motion is encoder noise; velocity and "
+                             "acceleration taken as zero");
+  }
+}
+
+// One warning per base parameter the data leave undetermined: why, and which motion would excite
+// it where that is cheap to say (its own joint, or the parameters it cannot be told from).
+void not_excited_warnings(const Model& model, const ParameterLayout& layout,
+                          const BaseParameters& base, const EquationBlock& based,
+                          const DataIdentifiability& data, std::vector<std::string>& warnings) {
+  std::ostringstream head;
+  head << "the data excite " << data.rank << " of the model's " << base.rank
+       << " base parameters (data rank; column-scaled singular values below " << data.tolerance
+       << " x the largest count as zero): the others are not estimated (not_excited)";
+  warnings.push_back(head.str());
+  for (int c : data.not_excited) {
+    const std::string& name = base.names[static_cast<size_t>(c)];
+    const int joint = column_joint(model, layout, base.base[static_cast<size_t>(c)]);
+    std::ostringstream w;
+    w << name << " is not excited: ";
+    if (based.W.col(c).squaredNorm() == 0.0) {
+      w << "its column is zero on every equation used";
+    } else {
+      std::string with;
+      for (size_t i = 0; i < data.kept.size(); ++i) {
+        for (const auto& [col, coef] : data.absorbs[i]) {
+          if (col == c)
+            with += (with.empty() ? "" : ", ") + base.names[static_cast<size_t>(data.kept[i])];
+        }
+      }
+      w << "the data cannot tell it from " << (with.empty() ? "the other parameters" : with)
+        << " (those estimates include its effect on these runs)";
+    }
+    if (joint >= 0) {
+      w << "; a run in which " << model.joints[static_cast<size_t>(joint)].name
+        << " moves (above its encoder noise, with both velocity signs and varied "
+           "configurations of the joints before it) would excite it";
+    }
+    warnings.push_back(w.str());
+  }
+}
+
 }  // namespace
 
 IdentificationResult identify(const Model& model, const JointRecord& record,
                               const IdentifyOptions& options) {
+  return identify(model, std::vector<JointRecord>{record}, options);
+}
+
+IdentificationResult identify(const Model& model, const std::vector<JointRecord>& runs,
+                              const IdentifyOptions& options) {
+  if (runs.empty()) throw Error("identify: no run given; pass at least one recorded run");
   const int n = model.dof();
   IdentificationResult result;
-  const ScreenedRun screened = screen_run(model, record, options.outliers);  // outliers.hpp
-  const CutoffSelection cutoff = select_cutoff(model, screened.record, options);
-  result.processed = preprocess_run(model, screened.record, cutoff.signal, result.choices);
-  echo_cutoff_selection(cutoff, result.choices);
-  const JointRecord& r = result.processed.record;
-  const Eigen::Index m = r.t.size();
-  result.samples = m;
-
   const bool coupling = options.coupling && !coupled_motors(model).empty();
+  // prepare + equations, one run at a time (each its own rate, filter edges, derivatives).
+  std::vector<EquationBlock> blocks;
+  std::vector<ScreenedRun> screened;
+  result.zero_velocity_threshold = Eigen::VectorXd::Zero(n);
+  for (size_t i = 0; i < runs.size(); ++i) {
+    std::vector<std::pair<std::string, std::string>> choices;
+    screened.push_back(screen_run(model, runs[i], options.outliers));  // outliers.hpp
+    // The cut-off of each run from its own data (held-out prediction, cutoff_selection.hpp).
+    const CutoffSelection cutoff = select_cutoff(model, screened.back().record, options);
+    ProcessedRecord processed =
+        preprocess_run(model, screened.back().record, cutoff.signal, choices);
+    echo_cutoff_selection(cutoff, choices);
+    hold_still_joints(model, processed, choices);
+    const Eigen::VectorXd threshold =
+        zero_velocity_threshold(options, processed, "removed", choices);
+    blocks.push_back(differential_equations(model, options.layout, coupling, processed, threshold));
+    RunSummary run;
+    run.samples = processed.record.t.size();
+    run.rows = blocks.back().y.size();
+    run.zero_velocity_threshold = threshold;
+    result.runs.push_back(run);
+    result.samples += run.samples;
+    // Validation leaves out the rows below the largest threshold any run used.
+    result.zero_velocity_threshold = result.zero_velocity_threshold.cwiseMax(threshold);
+    const std::string prefix = runs.size() > 1 ? "run " + std::to_string(i + 1) + " " : "";
+    for (auto& [key, value] : choices) result.choices.emplace_back(prefix + key, value);
+    if (i == 0) result.processed = std::move(processed);
+    result.warnings.insert(result.warnings.end(), screened.back().warnings.begin(),
+                           screened.back().warnings.end());
+  }
+  // stack + structural base columns (Gautier–Khalil, from the model).
   BaseParameterOptions base_options = options.base;
   base_options.layout = options.layout;
   base_options.coupling = coupling;
   result.base = compute_base_parameters(model, base_options);
-  result.names = result.base.names;
-  result.expressions = result.base.expressions;
   result.unidentifiable = result.base.unidentifiable_names();
   result.rank = result.base.rank;
-
-  const Eigen::VectorXd threshold =
-      zero_velocity_threshold(options, result.processed, "removed", result.choices);
-  result.zero_velocity_threshold = threshold;
-  const bool coulomb = options.layout.coulomb;
-  const Eigen::MatrixXd W_full =
-      processed_regressor(model, options.layout, coupling, result.processed);
-  std::vector<Eigen::Index> keep;
-  keep.reserve(m * n);
-  for (Eigen::Index k = 0; k < m; ++k) {
-    for (int j = 0; j < n; ++j) {
-      if (!coulomb || std::abs(r.dq(k, j)) >= threshold[j]) keep.push_back(k * n + j);
-    }
-  }
-  const Eigen::Index rows = static_cast<Eigen::Index>(keep.size());
-  result.rows = rows;
-  if (rows <= result.rank) {
-    throw Error("only " + std::to_string(rows) + " equations remain for " +
-                std::to_string(result.rank) +
+  EquationBlock based = select_base_columns(stack_equations(blocks), result.base);
+  result.rows = based.y.size();
+  // Data-identifiable columns: what these data determine of the base set.
+  const DataIdentifiability data = data_identifiability(based);
+  result.data_rank = data.rank;
+  if (result.rows <= data.rank) {
+    throw Error("only " + std::to_string(result.rows) + " equations remain for " +
+                std::to_string(data.rank) +
                 " base parameters; record a longer or faster run, or lower --zero-velocity");
   }
-  Eigen::MatrixXd W(rows, result.rank);
-  Eigen::VectorXd y(rows);
-  Eigen::VectorXi groups(rows);
-  for (Eigen::Index i = 0; i < rows; ++i) {
-    for (int c = 0; c < result.rank; ++c) W(i, c) = W_full(keep[i], result.base.base[c]);
-    y[i] = r.tau(keep[i] / n, keep[i] % n);
-    groups[i] = static_cast<int>(keep[i] % n);
+  if (data.rank == 0) {
+    throw Error(
+        "the data excite no parameter (no joint moves above its noise); record a run "
+        "in which the joints move");
   }
-  EstimationOptions eo;
+  const bool deficient = !data.not_excited.empty();
+  const EquationBlock W = deficient ? select_columns(based, data.kept) : based;
+  for (int c : data.kept) {
+    result.names.push_back(result.base.names[static_cast<size_t>(c)]);
+    result.expressions.push_back(result.base.expressions[static_cast<size_t>(c)]);
+  }
+  for (int c : data.not_excited) {
+    result.not_excited.push_back(result.base.names[static_cast<size_t>(c)]);
+  }
+  result.data_regrouping =
+      Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(data.kept.size()),
+                            static_cast<Eigen::Index>(data.not_excited.size()));
+  for (size_t i = 0; i < data.kept.size(); ++i) {
+    for (const auto& [col, coef] : data.absorbs[i]) {
+      const auto at = std::find(data.not_excited.begin(), data.not_excited.end(), col);
+      result.data_regrouping(static_cast<Eigen::Index>(i), at - data.not_excited.begin()) = coef;
+      std::ostringstream term;
+      term << std::setprecision(6) << (coef < 0 ? " - " : " + ") << std::abs(coef) << '*'
+           << result.base.names[static_cast<size_t>(col)] << " (on these data)";
+      result.expressions[i] += term.str();
+    }
+  }
+  if (deficient)
+    not_excited_warnings(model, options.layout, result.base, based, data, result.warnings);
+  // estimate
+  BlockEstimationOptions eo;
+  eo.estimator = options.estimator;
   eo.confidence_level = options.confidence_level;
-  eo.names = result.names;
-  switch (options.estimator) {
-    case IdentificationEstimator::kOls:
-      result.estimate = ordinary_least_squares(W, y, groups, eo);
-      break;
-    case IdentificationEstimator::kWls:
-      result.estimate = weighted_least_squares(W, y, groups, eo);
-      break;
-    case IdentificationEstimator::kRls:
-      result.estimate = recursive_least_squares(W, y, {}, eo);
-      break;
+  eo.hac_bandwidth = options.hac_bandwidth;
+  eo.record_history = options.record_history;
+  BlockEstimate fit = estimate_block(W, eo);
+  if (blocks.size() > 1 && fit.hac.bandwidth > 0) {
+    // Restack with runs a window apart and that window fixed, so that the HAC sums never pair two
+    // runs' errors (the estimate itself does not depend on the spacing).
+    eo.hac_bandwidth = fit.hac.bandwidth;
+    EquationBlock spaced = based;
+    spaced.sample =
+        select_base_columns(stack_equations(blocks, fit.hac.bandwidth + 1), result.base).sample;
+    if (deficient) spaced = select_columns(spaced, data.kept);
+    fit = estimate_block(spaced, eo);
+    fit.covariance_choice += "; runs stacked a window apart (no window spans two runs)";
   }
-  check_finite_estimate(result.estimate, screened);
-  // Residuals per joint, unweighted, on the rows used.
-  const Eigen::VectorXd e = y - W * result.estimate.x;
-  Eigen::VectorXd e2 = Eigen::VectorXd::Zero(n), y2 = Eigen::VectorXd::Zero(n),
-                  cnt = Eigen::VectorXd::Zero(n);
-  for (Eigen::Index i = 0; i < rows; ++i) {
-    e2[groups[i]] += e[i] * e[i];
-    y2[groups[i]] += y[i] * y[i];
-    cnt[groups[i]] += 1.0;
+  check_finite_estimate(fit.estimate, screened.front());
+  result.estimate = std::move(fit.estimate);
+  result.residual_rms = fit.group_rms;
+  result.joint_relative_error = fit.group_relative_error;
+  result.relative_error = fit.relative_error;
+  result.residual_autocorrelation = fit.group_autocorrelation;
+  result.choices.emplace_back("covariance", fit.covariance_choice);
+  result.history_t = std::move(fit.history_t);
+  result.history_x = std::move(fit.history_x);
+  result.history_std = std::move(fit.history_std);
+  if (options.estimator == IdentificationEstimator::kRls) {
+    result.excitation = persistent_excitation(W, options.excitation_window);
+    result.has_excitation = true;
   }
-  result.residual_rms = (e2.array() / cnt.array().max(1.0)).sqrt();
-  result.joint_relative_error = (e2.array() / y2.array().max(1e-300)).sqrt();
-  result.relative_error = e.norm() / y.norm();
-  // Lag-1 autocorrelation of each joint's residual series over consecutive kept samples: the
-  // intervals assume white residuals; filtered data or unmodelled dynamics make them correlated.
-  {
-    Eigen::VectorXd lag = Eigen::VectorXd::Zero(n), prev_e = Eigen::VectorXd::Zero(n);
-    std::vector<Eigen::Index> prev_k(n, -2);
-    for (Eigen::Index i = 0; i < rows; ++i) {
-      const int j = groups[i];
-      const Eigen::Index k = keep[i] / n;
-      if (k == prev_k[j] + 1) lag[j] += e[i] * prev_e[j];
-      prev_k[j] = k;
-      prev_e[j] = e[i];
-    }
-    result.residual_autocorrelation = lag.array() / e2.array().max(1e-300);
-    std::string correlated;
-    double worst = 0.0;
-    for (int j = 0; j < n; ++j) {
-      if (result.residual_autocorrelation[j] > kCorrelatedResidualWarning) {
-        correlated += (correlated.empty() ? "" : ", ") + model.joints[j].name;
-        worst = std::max(worst, result.residual_autocorrelation[j]);
-      }
-    }
-    // Default intervals: HAC sandwich over samples (the estimator's own bread, so WLS weights and
-    // the RLS prior carry over); the white-noise ones stay as std_white.
-    Eigen::MatrixXd Ws = W;
-    Eigen::VectorXd es = e;
-    if (options.estimator == IdentificationEstimator::kWls) {
-      for (Eigen::Index i = 0; i < rows; ++i) {
-        const double v = result.estimate.group_variance[groups[i]];
-        const double w = v > 0.0 && std::isfinite(v) ? 1.0 / std::sqrt(v) : 1.0;
-        Ws.row(i) *= w;
-        es[i] *= w;
-      }
-    }
-    Eigen::VectorXi sample(rows);
-    for (Eigen::Index i = 0; i < rows; ++i) sample[i] = static_cast<int>(keep[i] / n);
-    HacOptions hac;
-    hac.bandwidth = options.hac_bandwidth;
-    const HacSummary h = apply_hac_covariance(result.estimate, Ws, es, sample, eo, hac);
-    std::ostringstream c;
-    c << std::setprecision(3);
-    if (result.estimate.covariance_kind == "white") {
-      c << "white-noise sigma^2 (W^T W)^-1 (no residual degrees of freedom for a sandwich)";
-    } else {
-      c << "Newey-West (HAC) sandwich over samples, Bartlett window of " << h.bandwidth
-        << " samples (" << (options.hac_bandwidth >= 0 ? "given" : "Andrews AR(1) rule, b >= 0.02")
-        << "), ci_* = value -+ " << h.critical_value
-        << " std (fixed-b critical value at b = " << h.b
-        << ", Kiefer-Vogelsang 2005): std and ci_* allow for correlated residuals "
-           "(filtering, unmodelled dynamics); std_white assumes white residuals and is "
-        << h.median_ratio << "x smaller (median)";
-    }
-    result.choices.emplace_back("covariance", c.str());
-    if (!correlated.empty()) {
-      std::ostringstream w;
-      w << "residuals of " << correlated << " are correlated (lag-1 autocorrelation up to "
-        << std::setprecision(2) << worst
-        << "): filtered noise or dynamics the model lacks; std/ci_* account for it (HAC), "
-           "std_white would be about "
-        << std::setprecision(2) << h.median_ratio
-        << "x too narrow; judge the model on a validation run";
-      result.estimate.summary.warnings.push_back(w.str());
-    }
+  // Per run: the relative error of its own rows.
+  Eigen::Index at = 0;
+  for (auto& run : result.runs) {
+    const auto e = fit.residual.segment(at, run.rows);
+    const auto y = W.y.segment(at, run.rows);
+    run.relative_error = e.norm() / std::max(y.norm(), 1e-300);
+    at += run.rows;
   }
   result.condition_number = result.estimate.summary.condition_number;
   if (!(result.condition_number > 0.0)) {
-    const Eigen::VectorXd s = Eigen::BDCSVD<Eigen::MatrixXd>(W).singularValues();
+    const Eigen::VectorXd s = Eigen::BDCSVD<Eigen::MatrixXd>(W.W).singularValues();
     result.condition_number = s[s.size() - 1] > 0.0 ? s[0] / s[s.size() - 1] : INFINITY;
   }
-  result.warnings = screened.warnings;
   result.warnings.insert(result.warnings.end(), result.estimate.summary.warnings.begin(),
                          result.estimate.summary.warnings.end());
   return result;
@@ -509,8 +574,12 @@ ValidationResult validate_torques(const Model& model, const JointRecord& record,
   ValidationResult out;
   out.processed = preprocess_run(model, record, options.signal, out.choices);
   const JointRecord& r = out.processed.record;
-  const std::vector<std::string> columns = stacked_regressor_names(
-      model, options.layout, options.coupling && !coupled_motors(model).empty());
+  // The same equations as identify(): every row for the headline figures, and the rows its
+  // zero-velocity rule keeps (near-still rows of a Coulomb model: their sign(dq) is noise).
+  const EquationBlock all = differential_equations(
+      model, options.layout, options.coupling && !coupled_motors(model).empty(), out.processed,
+      Eigen::VectorXd());
+  const std::vector<std::string>& columns = all.columns;
   // Each identified parameter selects its leading standard column: W_b·theta_b uses the base
   // columns only (W_2 = W_1·K_d is folded into theta_b).
   Eigen::VectorXd theta = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(columns.size()));
@@ -528,29 +597,25 @@ ValidationResult validate_torques(const Model& model, const JointRecord& record,
     }
     theta[it - columns.begin()] = values[static_cast<Eigen::Index>(i)];
   }
-  const Eigen::MatrixXd W = processed_regressor(
-      model, options.layout, options.coupling && !coupled_motors(model).empty(), out.processed);
-  const Eigen::VectorXd pred = W * theta;
+  const Eigen::VectorXd pred = all.W * theta;
   const Eigen::Index m = r.t.size();
   out.samples = m;
   out.predicted =
       Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
           pred.data(), m, n);
-  // Errors on the joint equations identify() would use: near-zero-velocity rows of a Coulomb
-  // model are left out the same way (their sign(dq) is noise), and reported apart.
   const Eigen::VectorXd threshold = zero_velocity_threshold(
       options, out.processed, "left out of the error statistics", out.choices);
   out.zero_velocity_threshold = threshold;
   const Eigen::MatrixXd e = r.tau - out.predicted;
+  const EquationBlock moving = moving_rows(all, r.dq, threshold);
+  const Eigen::VectorXd e_moving = moving.y - moving.W * theta;
   Eigen::VectorXd e2 = Eigen::VectorXd::Zero(n), y2 = Eigen::VectorXd::Zero(n),
                   cnt = Eigen::VectorXd::Zero(n);
-  for (Eigen::Index k = 0; k < m; ++k) {
-    for (int j = 0; j < n; ++j) {
-      if (std::abs(r.dq(k, j)) < threshold[j]) continue;
-      e2[j] += e(k, j) * e(k, j);
-      y2[j] += r.tau(k, j) * r.tau(k, j);
-      cnt[j] += 1.0;
-    }
+  for (Eigen::Index i = 0; i < moving.y.size(); ++i) {
+    const int j = moving.group[i];
+    e2[j] += e_moving[i] * e_moving[i];
+    y2[j] += moving.y[i] * moving.y[i];
+    cnt[j] += 1.0;
   }
   out.rows = static_cast<Eigen::Index>(cnt.sum());
   out.rows_excluded = m * n - out.rows;

@@ -366,6 +366,16 @@ IdentificationResult identify_stream(const Model& model, const std::string& path
   result.relative_error = result.estimate.relative_error;
   result.condition_number = result.estimate.summary.condition_number;
   result.warnings = result.estimate.summary.warnings;
+  // The stream keeps no regressor to split off unexcited columns: its data rank is the solve's
+  // numerical rank (unexcited parameters keep σ = inf here; identify without --stream names them).
+  result.data_rank = static_cast<int>(result.estimate.summary.rank);
+  RunSummary run;
+  run.file = path;
+  run.samples = samples;
+  run.rows = result.rows;
+  run.relative_error = result.relative_error;
+  run.zero_velocity_threshold = s.threshold;
+  result.runs.push_back(run);
   return result;
 }
 

@@ -75,6 +75,25 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
   }
   nlohmann::json choices = nlohmann::json::object();
   for (const auto& [k, v] : r.choices) choices[k] = v;
+  nlohmann::json runs = nlohmann::json::array();
+  for (const auto& run : r.runs) {
+    runs.push_back({{"file", run.file},
+                    {"samples", run.samples},
+                    {"rows", run.rows},
+                    {"relative_error", json_number(run.relative_error)}});
+  }
+  // Present only with RLS; no nulls in results (holds is false when the condition never holds).
+  nlohmann::json excitation = nlohmann::json::object();
+  if (r.has_excitation) {
+    excitation = {{"window", r.excitation.window},
+                  {"windows", r.excitation.windows},
+                  {"min_eigenvalue", json_number(r.excitation.min_eigenvalue)},
+                  {"max_eigenvalue", json_number(r.excitation.max_eigenvalue)},
+                  {"holds", std::isfinite(r.excitation.holds_from_t)}};
+    if (std::isfinite(r.excitation.holds_from_t)) {
+      excitation["holds_from_t"] = r.excitation.holds_from_t;
+    }
+  }
   return {{"model",
            {{"name", model.name},
             {"source", model.source},
@@ -83,6 +102,10 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
           {"parameters", params},
           {"confidence_level", e.confidence_level},
           {"rank", r.rank},
+          {"data_rank", r.data_rank},
+          {"not_excited", r.not_excited},
+          {"runs", runs},
+          {"excitation", excitation},
           {"condition_number", json_number(r.condition_number)},
           {"samples", r.samples},
           {"rows", r.rows},
@@ -116,6 +139,18 @@ std::string identification_table(const Model& model, const IdentificationResult&
       "\nrank %d, condition number %.4g, %ld samples, %ld equations, relative error %.2f %%\n",
       r.rank, r.condition_number, static_cast<long>(r.samples), static_cast<long>(r.rows),
       100 * r.relative_error);
+  if (!r.not_excited.empty()) {
+    s << "data rank " << r.data_rank << " < " << r.rank << "; not excited (not estimated):";
+    for (const auto& name : r.not_excited) s << ' ' << name;
+    s << '\n';
+  }
+  if (r.runs.size() > 1) {
+    for (size_t i = 0; i < r.runs.size(); ++i) {
+      s << line("  run %zu %s: %ld samples, %ld equations, relative error %.2f %%\n", i + 1,
+                one_line(r.runs[i].file).c_str(), static_cast<long>(r.runs[i].samples),
+                static_cast<long>(r.runs[i].rows), 100 * r.runs[i].relative_error);
+    }
+  }
   const int w = name_width(model, 12);
   for (int j = 0; j < model.dof(); ++j) {
     s << line("  %-*s residual RMS %.4g, relative error %.2f %%\n", w, model.joints[j].name.c_str(),
@@ -310,6 +345,30 @@ void write_validation_predictions(const std::string& path, const ValidationResul
     const double threshold =
         j < v.zero_velocity_threshold.size() ? v.zero_velocity_threshold[j] : 0;
     data.col(4 + 4 * j) = (r.dq.col(j).array().abs() < threshold).cast<double>();
+  }
+  write_csv(path, columns, data);
+}
+
+void write_rls_history(const std::string& path, const IdentificationResult& r) {
+  const Eigen::Index rows = r.history_x.rows(), p = r.history_x.cols();
+  if (rows == 0 || static_cast<Eigen::Index>(r.names.size()) != p) {
+    throw Error("no RLS history to write to '" + path + "'; identify with --estimator rls");
+  }
+  // σ after k equations needs k > p (residual degrees of freedom): start there.
+  Eigen::Index first = 0;
+  while (first < rows && !r.history_std.row(first).allFinite()) ++first;
+  if (first == rows) {
+    throw Error("the RLS history has no equation with a finite sigma; '" + path +
+                "' not written (more equations than parameters are needed)");
+  }
+  std::vector<std::string> columns = {"t"};
+  Eigen::MatrixXd data(rows - first, 1 + 2 * p);
+  data.col(0) = r.history_t.segment(first, rows - first);
+  for (Eigen::Index c = 0; c < p; ++c) {
+    columns.push_back(r.names[static_cast<size_t>(c)]);
+    columns.push_back(r.names[static_cast<size_t>(c)] + "_std");
+    data.col(1 + 2 * c) = r.history_x.col(c).segment(first, rows - first);
+    data.col(2 + 2 * c) = r.history_std.col(c).segment(first, rows - first);
   }
   write_csv(path, columns, data);
 }

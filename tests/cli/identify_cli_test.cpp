@@ -282,3 +282,96 @@ TEST(IdentifyCli, ExciteSimulateIdentifyChain) {
 }
 
 }  // namespace
+
+namespace {
+
+// planar2 with joint 2 held at q2 = 0.5 rad (its torque from the same closed form, see
+// planar2_run): joint 2's inertia about its own axis and its friction are not excited.
+std::string planar2_joint2_still() {
+  const std::string path = ::testing::TempDir() + "/planar2_joint2_still.csv";
+  std::ofstream f(path);
+  f << "t,q1,q2,dq1,dq2,ddq1,ddq2,tau1,tau2\n";
+  const double m1 = 2.0, m2 = 1.5, l1 = 1.0, c1 = 0.5, c2 = 0.4, I1 = 2.0 / 12,
+               I2 = 1.5 * 0.64 / 12, g = 9.81, q2 = 0.5;
+  for (int k = 0; k < 2000; ++k) {
+    const double t = k * 0.01;
+    const double q1 = std::sin(0.7 * t) + 0.3 * std::sin(2.1 * t);
+    const double dq1 = 0.7 * std::cos(0.7 * t) + 0.63 * std::cos(2.1 * t);
+    const double ddq1 = -0.49 * std::sin(0.7 * t) - 1.323 * std::sin(2.1 * t);
+    const double d11 =
+        m1 * c1 * c1 + m2 * (l1 * l1 + c2 * c2 + 2 * l1 * c2 * std::cos(q2)) + I1 + I2;
+    const double d12 = m2 * (c2 * c2 + l1 * c2 * std::cos(q2)) + I2;
+    const double h = -m2 * l1 * c2 * std::sin(q2);
+    const double g1 = (m1 * c1 + m2 * l1) * g * std::cos(q1) + m2 * c2 * g * std::cos(q1 + q2);
+    const double g2 = m2 * c2 * g * std::cos(q1 + q2);
+    f << t << ',' << q1 << ',' << q2 << ',' << dq1 << ",0," << ddq1 << ",0," << d11 * ddq1 + g1
+      << ',' << d12 * ddq1 - h * dq1 * dq1 + g2 << '\n';
+  }
+  return path;
+}
+
+}  // namespace
+
+TEST(IdentifyCli, SeveralRunsAreStackedAndReportedPerRun) {
+  const std::string data = planar2_run(), still = planar2_joint2_still();
+  const std::string out = ::testing::TempDir() + "/planar2_two_runs.json";
+  const std::string flags = " --friction none --no-armature --filter none --out " + out;
+  const CliRun r = run("identify --robot planar2 --data " + data + " --data " + still + flags);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = load(out);
+  ASSERT_EQ(j["runs"].size(), 2u);
+  EXPECT_EQ(j["runs"][0]["file"], data);
+  EXPECT_EQ(j["runs"][1]["file"], still);
+  EXPECT_EQ(j["runs"][0]["rows"].get<int>() + j["runs"][1]["rows"].get<int>(), j["rows"]);
+  EXPECT_EQ(j["runs"][0]["samples"], 2000);
+  EXPECT_EQ(j["data_rank"], j["rank"]);
+  EXPECT_TRUE(j["not_excited"].empty());
+  // Noise-free closed-form data written with 6 significant digits: both runs fit to that precision.
+  EXPECT_LT(j["runs"][0]["relative_error"].get<double>(), 1e-5);
+  EXPECT_LT(j["runs"][1]["relative_error"].get<double>(), 1e-5);
+  const CliRun stream =
+      run("identify --robot planar2 --stream --data " + data + " --data " + still + flags);
+  EXPECT_EQ(stream.code, 2);
+  EXPECT_NE(stream.err.find("error: --stream reads one run"), std::string::npos) << stream.err;
+}
+
+TEST(IdentifyCli, ParametersTheRunDoesNotExciteAreNamedNotEstimated) {
+  const std::string out = ::testing::TempDir() + "/planar2_still.json";
+  const CliRun r = run("identify --robot planar2 --data " + planar2_joint2_still() +
+                       " --friction viscous --filter none --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = load(out);
+  // Joint 2 never moves: its actuator inertia and viscous friction have no effect on the data
+  // (its link's inertial parameters still act through joint 1's motion and gravity).
+  EXPECT_EQ(j["data_rank"].get<int>(), j["rank"].get<int>() - 2);
+  EXPECT_EQ(j["not_excited"], nlohmann::json::array({"Ia2", "Fv2"}));
+  EXPECT_EQ(j["parameters"].size() + j["not_excited"].size(), j["rank"].get<size_t>());
+  for (const auto& p : j["parameters"]) {
+    EXPECT_TRUE(p["std"].is_number()) << p["name"];
+    for (const auto& name : j["not_excited"]) EXPECT_NE(p["name"], name);
+  }
+  EXPECT_NE(r.out.find("not excited"), std::string::npos) << r.out;
+}
+
+TEST(IdentifyCli, RlsHistoryIsWrittenAndNeedsRls) {
+  const std::string data = planar2_run();
+  const std::string out = ::testing::TempDir() + "/planar2_rls.json";
+  const std::string history = ::testing::TempDir() + "/planar2_history.csv";
+  std::remove(history.c_str());
+  const CliRun r = run("identify --robot planar2 --data " + data +
+                       " --friction none --no-armature --filter none --estimator rls --history " +
+                       history + " --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream f(history);
+  std::string header;
+  std::getline(f, header);
+  EXPECT_EQ(header.rfind("t,ZZ1R,ZZ1R_std,", 0), 0u) << header;
+  const auto j = load(out);
+  EXPECT_TRUE(j["excitation"].is_object());
+  EXPECT_GT(j["excitation"]["min_eigenvalue"].get<double>(), 0.0);
+  EXPECT_TRUE(j["excitation"]["holds"].get<bool>());
+  const CliRun bad =
+      run("identify --robot planar2 --data " + data + " --history " + history + " --out " + out);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("error: --history needs --estimator rls"), std::string::npos) << bad.err;
+}

@@ -85,6 +85,30 @@ struct IdentifyOptions {
   SignalOptions signal;       ///< filtering, derivatives, decimation, sample removal
   BaseParameterOptions base;  ///< base-parameter computation (layout is overwritten)
   OutlierOptions outliers;    ///< gross torque outliers: report or drop (outliers.hpp)
+  /// With the RLS estimator: keep the estimate and σ after every equation (history_* of the
+  /// result; memory grows with the rows).
+  bool record_history = false;
+  /// Persistent-excitation window ρ (equations) of the RLS excitation report; 0 = max(10 ×
+  /// parameters, equations/10).
+  int excitation_window = 0;
+};
+
+/// One run of a (possibly several-run) identification.
+struct RunSummary {
+  std::string file;             ///< where the run came from (set by the caller; may be empty)
+  Eigen::Index samples = 0;     ///< samples after processing
+  Eigen::Index rows = 0;        ///< equations the run contributed
+  double relative_error = 0.0;  ///< ‖e‖/‖y‖ over the run's equations, at the joint estimate
+  Eigen::VectorXd zero_velocity_threshold;  ///< per joint, as for the whole result
+};
+
+/// Persistent excitation of the equations (seed 1 eq. 38), reported with the RLS estimator.
+struct ExcitationSummary {
+  int window = 0;               ///< ρ, equations per window
+  double min_eigenvalue = 0.0;  ///< α over all windows (column-scaled regressor)
+  double max_eigenvalue = 0.0;  ///< β over all windows
+  double holds_from_t = 0.0;    ///< time [s] from which the condition holds; NaN if never
+  int windows = 0;              ///< windows evaluated
 };
 
 /// The preprocessed data actually used for estimation (useful for plots and validation).
@@ -126,8 +150,21 @@ struct IdentificationResult {
   /// Per joint, the |dq_j| below which rows were left out of the fit [rad/s or m/s]; zeros when
   /// none were (validate_torques reuses these, so a validation compares the same kind of rows).
   Eigen::VectorXd zero_velocity_threshold;
-  BaseParameters base;        ///< the base set on which the estimate lives
-  ProcessedRecord processed;  ///< the data as used
+  BaseParameters base;           ///< the base set on which the estimate lives
+  ProcessedRecord processed;     ///< the data as used (the first run's)
+  std::vector<RunSummary> runs;  ///< per run, in the order given
+  /// Rank of the stacked base regressor on these data (= rank when the data excite every base
+  /// parameter); names/estimate hold only the data-identifiable ones.
+  int data_rank = 0;
+  std::vector<std::string> not_excited;  ///< base parameters the data do not determine
+  /// names.size() × not_excited.size(): on these data each estimate is its base parameter plus
+  /// data_regrouping·θ(not_excited) (the data cannot separate them); its expression says so.
+  Eigen::MatrixXd data_regrouping;
+  bool has_excitation = false;   ///< excitation is filled (RLS)
+  ExcitationSummary excitation;  ///< persistent excitation (seed 1 eq. 38)
+  /// With IdentifyOptions::record_history and RLS: per equation its time [s], the estimate and σ.
+  Eigen::VectorXd history_t;
+  Eigen::MatrixXd history_x, history_std;
 };
 
 /// Sample-major stacked regressor of the layout plus coupling columns for a record:
@@ -149,6 +186,15 @@ ProcessedRecord preprocess(const JointRecord& record, const SignalOptions& optio
 /// estimate by OLS, Gautier's WLS or U-D RLS (seed 1 eqs. 36–37), and report statistics.
 /// Throws dynid::Error for inconsistent sizes, NaN, too few samples.
 IdentificationResult identify(const Model& model, const JointRecord& record,
+                              const IdentifyOptions& options = {});
+
+/// identify() of several runs together (issue 11 item 2): each run is screened and preprocessed
+/// on its own (its own rate, filter edges, derivatives, zero-velocity thresholds), its equations
+/// built, and the blocks stacked (stack_equations) before the base columns and the estimate; the
+/// result's runs[] report each run. Base parameters the stacked data do not excite (data rank
+/// below the model rank, data_identifiability) are named in not_excited and not estimated.
+/// Throws dynid::Error for no run and as identify().
+IdentificationResult identify(const Model& model, const std::vector<JointRecord>& runs,
                               const IdentifyOptions& options = {});
 
 /// Per-joint prediction error of identified base parameters on another record (dynid validate).

@@ -70,6 +70,11 @@ std::string validation_table(const Model& model, const ValidationResult& v);
 /// atomically; throws dynid::Error as write_csv.
 void write_validation_predictions(const std::string& path, const ValidationResult& v);
 
+/// Writes the RLS history of an identification (IdentifyOptions::record_history) as CSV: `t`, then
+/// per parameter NAME its value and NAME_std, one line per equation from the first with a residual
+/// degree of freedom (σ is undefined before). Throws dynid::Error when the result has no history.
+void write_rls_history(const std::string& path, const IdentificationResult& r);
+
 /// `dynid validate --mode simulation` JSON: `joints` (name, position {rms, max, mean, std,
 /// skewness, kurtosis, ks_statistic, ks_p_value}, torque {same}), `samples`, `version`.
 nlohmann::json simulation_validation_to_json(const Model& model, const SimulationValidation& v);
