@@ -12,10 +12,15 @@
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
+#include "dynid/estimation/decoupled_model.hpp"
+#include "dynid/estimation/friction_experiment.hpp"
+#include "dynid/estimation/gravity_experiment.hpp"
+#include "dynid/estimation/physical_parameters.hpp"
 #include "dynid/io/joint_record_file.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/io/streaming_identification.hpp"
 #include "dynid/model/robots.hpp"
+#include "dynid/report/experiment_report.hpp"
 #include "dynid/report/identification_report.hpp"
 #include "dynid/sim/simulate_reference.hpp"
 
@@ -41,6 +46,12 @@ struct IdentifyCliOptions {
   std::vector<double> torque_scale;
   std::string rows, time;
   std::string outliers = "report";
+  std::string model = "differential";  // --model
+  double interval = 0.01;              // --interval (integral model)
+  bool long_integrals = false;         // --long (integral model)
+  int joint = 0;                       // --joint (gravity, friction, decoupled), 1-based
+  std::string params;                  // --params (friction: compensation model)
+  bool physical = false;               // --physical
 };
 
 // The run named by `flag` must be a readable file (so the error names the flag the user gave).
@@ -181,6 +192,15 @@ IdentifyOptions library_options(const IdentifyCliOptions& o) {
     throw UsageError("--outliers must be report or drop, not '" + o.outliers + "'");
   }
   out.outliers.policy = o.outliers == "drop" ? OutlierPolicy::kDrop : OutlierPolicy::kReport;
+  if (o.model == "integral") {
+    out.model = IdentificationModel::kIntegral;
+    if (!(o.interval >= 0.0)) {
+      throw UsageError("--interval " + std::to_string(o.interval) +
+                       " is negative; give the interval length in seconds, e.g. 0.01");
+    }
+    out.integral.interval = o.interval;
+    out.integral.long_integrals = o.long_integrals;
+  }
   return out;
 }
 
@@ -201,6 +221,7 @@ nlohmann::json echo(const IdentifyCliOptions& o) {
           {"torque_offset_s", o.torque_offset},
           {"filter_coulomb_columns", o.filter_coulomb},
           {"outliers", o.outliers},
+          {"model", o.model},
           {"columns", o.columns},
           {"torque_scale", o.torque_scale},
           {"rows", o.rows},
@@ -264,8 +285,115 @@ void warn_identify_no_effect(const IdentifyCliOptions& o, const CLI::App& cmd) {
   if (!o.stream && cmd.count("--threads")) warn("--threads has no effect without --stream");
 }
 
+// The options a result JSON records, read with the file and key named in any error (a wrong type
+// is the file's fault, not a command-line flag's).
+struct FileOptions {
+  const nlohmann::json& used;
+  const std::string& path;
+  template <typename T>
+  T get(const char* key, const T& fallback) const {
+    if (!used.contains(key)) return fallback;
+    try {
+      return used.at(key).get<T>();
+    } catch (const nlohmann::json::exception&) {
+      throw Error("'" + path + "': options." + key + " has the wrong type (" +
+                  used.at(key).type_name() + "); give the result.json of dynid identify unedited");
+    }
+  }
+};
+
+// The model whose rigid-body and armature torques a friction experiment subtracts: the robot's
+// nominal one, or the one identified in `params` (its base parameters, the rest nominal).
+Model compensation_model(const Model& model, const std::string& params) {
+  if (params.empty()) return model;
+  const IdentifiedResultFile f = read_identification_result(params);
+  if (!f.robot.empty() && f.robot != model.name) {
+    throw Error("'" + params + "' was identified on robot '" + f.robot + "' but --robot gives '" +
+                model.name + "'; give a result of this robot");
+  }
+  IdentifyCliOptions o;
+  const FileOptions file_options{f.options, params};
+  o.friction = file_options.get("friction", o.friction);
+  o.no_armature = !file_options.get("armature", true);
+  return identified_model(model, f.names, f.values, library_options(o));
+}
+
+// `identify --model gravity|friction|decoupled`: seed 2's dedicated experiments on one joint.
+void run_experiment(const IdentifyCliOptions& o, const IdentifyOptions& options,
+                    const RunFileOptions& file) {
+  if (o.stream) throw UsageError("--stream is for the differential model; drop it");
+  if (options.estimator != IdentificationEstimator::kOls) {
+    throw UsageError("--model " + o.model + " fits by least squares; drop --estimator");
+  }
+  const Model model = load_robot(o.robot);
+  if (o.joint < 1 || o.joint > model.dof()) {
+    throw UsageError("--joint " + std::to_string(o.joint) + " is not a joint of '" + model.name +
+                     "'; give 1 to " + std::to_string(model.dof()));
+  }
+  if (!o.params.empty()) require_readable(o.params, "--params");
+  RunFileReport read;
+  std::vector<ProcessedRecord> runs;
+  std::vector<std::pair<std::string, std::string>> choices;
+  for (const auto& path : o.runs) {
+    const JointRecord record = read_joint_record(path, model, file, &read);
+    if (record.q.cols() != model.dof()) {
+      throw Error("'" + path + "' has " + std::to_string(record.q.cols()) + " joints but model '" +
+                  model.name + "' has " + std::to_string(model.dof()));
+    }
+    runs.push_back(preprocess(record, options.signal, choices));
+  }
+  const int j = o.joint - 1;
+  nlohmann::json used = echo(o);
+  used["joint"] = o.joint;
+  used["data_runs"] = o.runs;
+  nlohmann::json result;
+  if (o.model == "gravity") {
+    GravityExperimentOptions go;
+    go.confidence_level = options.confidence_level;
+    GravityExperimentResult r = fit_gravity_experiment(runs, j, go);
+    r.choices.insert(r.choices.begin(), choices.begin(), choices.end());
+    result = gravity_experiment_to_json(model, r, used);
+  } else if (o.model == "friction") {
+    FrictionExperimentOptions fo;
+    fo.confidence_level = options.confidence_level;
+    FrictionExperimentResult r =
+        fit_friction_experiment(compensation_model(model, o.params), runs, j, fo);
+    r.choices.insert(r.choices.begin(), choices.begin(), choices.end());
+    result = friction_experiment_to_json(model, r, used);
+  } else {
+    DecoupledModelOptions dm;
+    dm.confidence_level = options.confidence_level;
+    DecoupledJointResult r = fit_decoupled_joint(runs, j, dm);
+    r.choices.insert(r.choices.begin(), choices.begin(), choices.end());
+    result = decoupled_model_to_json(model, r, used);
+  }
+  std::vector<std::pair<std::string, std::string>> echoed;
+  for (auto& [k, v] : result["choices"].items()) echoed.emplace_back(k, v.get<std::string>());
+  echo_choices("identify", read, echoed);
+  std::cout << experiment_table(result);
+  write_json(o.out, result);
+  std::cout << "wrote " << o.out << '\n';
+}
+
 void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   o.data = o.runs.empty() ? std::string() : o.runs.front();
+  if (o.model != "differential" && o.model != "integral" && o.model != "gravity" &&
+      o.model != "friction" && o.model != "decoupled") {
+    throw UsageError(
+        "--model must be differential, integral, gravity, friction or decoupled, not '" + o.model +
+        "'");
+  }
+  const bool experiment = o.model == "gravity" || o.model == "friction" || o.model == "decoupled";
+  if (!experiment && cmd.count("--joint")) warn("--joint has no effect with --model " + o.model);
+  if (o.model != "friction" && !o.params.empty()) {
+    warn("--params has no effect with --model " + o.model);
+  }
+  if (o.model != "integral" && (cmd.count("--interval") || o.long_integrals)) {
+    warn("--interval and --long have no effect with --model " + o.model);
+  }
+  if (o.model == "integral" && o.stream) {
+    throw UsageError("--stream is for the differential model; drop it with --model integral");
+  }
   IdentifyOptions options = library_options(o);
   const RunFileOptions file = run_file_options(o.columns, o.rate, o.torque_scale, o.rows, o.time);
   if (!o.history.empty() && options.estimator != IdentificationEstimator::kRls) {
@@ -288,6 +416,10 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
         "--columns by position need the in-memory mode (drop --stream)");
   }
   warn_identify_no_effect(o, cmd);
+  if (experiment) {
+    run_experiment(o, options, file);
+    return;
+  }
   const Model model = load_robot(o.robot);
   RunFileReport read;
   IdentificationResult result;
@@ -308,30 +440,35 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   used["filter_coulomb_columns"] = result.processed.moving_positive.size() != 0;
   if (o.runs.size() > 1) used["data_runs"] = o.runs;
   if (!o.history.empty()) used["history"] = o.history;
-  write_json(o.out, identification_to_json(model, result, used));
+  nlohmann::json out = identification_to_json(model, result, used);
+  if (o.physical) {
+    if (!result.not_excited.empty()) {
+      throw Error(
+          "--physical needs every base parameter determined by the data; these are not "
+          "excited: " +
+          result.not_excited.front() + (result.not_excited.size() > 1 ? " and others" : "") +
+          " (record a run that moves every joint)");
+    }
+    const PhysicalFit fit = physical_parameters(model, result.base, options.layout,
+                                                result.estimate.x, result.estimate.covariance);
+    // The torque error of the consistent set beside the unconstrained one, on the first run.
+    const JointRecord first = read_joint_record(o.runs.front(), model, file, nullptr);
+    IdentifyOptions same = options;
+    same.signal.cutoff_hz = result.processed.cutoff_hz;
+    const double physical_error =
+        validate_torques(model, first, result.names, fit.theta_b, same).relative_error_all;
+    const double free_error =
+        validate_torques(model, first, result.names, result.estimate.x, same).relative_error_all;
+    physical_parameters_to_json(fit, physical_error, free_error, out);
+    std::cout << physical_parameters_text(fit, physical_error, free_error);
+  }
+  write_json(o.out, out);
   std::cout << "wrote " << o.out << '\n';
   if (!o.history.empty()) {
     write_rls_history(o.history, result);
     std::cout << "wrote " << o.history << '\n';
   }
 }
-
-// The options a result JSON records, read with the file and key named in any error (a wrong type
-// is the file's fault, not a command-line flag's).
-struct FileOptions {
-  const nlohmann::json& used;
-  const std::string& path;
-  template <typename T>
-  T get(const char* key, const T& fallback) const {
-    if (!used.contains(key)) return fallback;
-    try {
-      return used.at(key).get<T>();
-    } catch (const nlohmann::json::exception&) {
-      throw Error("'" + path + "': options." + key + " has the wrong type (" +
-                  used.at(key).type_name() + "); give the result.json of dynid identify unedited");
-    }
-  }
-};
 
 // A usage error raised by an option value read from a result file: the file and its key are at
 // fault, not the command-line flag the message names (exit 1, not 2).
@@ -505,6 +642,23 @@ void add_identify_command(CLI::App& app) {
   cmd->add_option("--history", o->history,
                   "With --estimator rls: write the estimate after every equation as CSV (t, then "
                   "NAME and NAME_std per parameter), to watch when each parameter settles");
+  cmd->add_option("--model", o->model,
+                  "differential (joint torques, default), integral (energy over intervals: "
+                  "Dutkiewicz, Kozlowski, Wroblewski 1993), or one joint's dedicated experiment "
+                  "(Bona, Curatella 2005): gravity (constant-velocity slopes), friction "
+                  "(bang-bang moves, inertia and gravity compensated) or decoupled (one joint "
+                  "moving, the others held)");
+  cmd->add_option("--interval", o->interval,
+                  "Integral model: interval length [s] (default 0.01; 0 = two samples)");
+  cmd->add_flag("--long", o->long_integrals,
+                "Integral model: long integrals growing from the first sample");
+  cmd->add_option("--joint", o->joint, "gravity, friction, decoupled: the joint (1-based)");
+  cmd->add_option("--params", o->params,
+                  "friction: result.json whose identified model compensates inertia and gravity "
+                  "(default: the robot's nominal model)");
+  cmd->add_flag("--physical", o->physical,
+                "Also fit physically consistent standard parameters (mass > 0, realisable "
+                "inertia, friction >= 0; log-Cholesky, Rucker and Wensing 2022) to the estimate");
   cmd->add_option("--estimator", o->estimator, "ols, wls (Gautier two-step) or rls (U-D recursive)")
       ->capture_default_str();
   cmd->add_option("--confidence", o->confidence, "Confidence level of the intervals")

@@ -13,12 +13,6 @@ namespace dynid {
 
 namespace {
 
-double median(std::vector<double> v) {
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
-
 struct Slope {
   int run = 0;
   int direction = 1;
@@ -37,10 +31,26 @@ Slope find_slope(const ProcessedRecord& p, int r, int joint, int direction,
   const double peak = v.maxCoeff();
   const double noise = p.velocity_noise_std.size() > joint ? p.velocity_noise_std[joint] : 0.0;
   if (!(peak > 3.0 * noise) || !(peak > 0.0)) return s;
-  std::vector<double> fast;
+  // The cruise velocity is the most populated one: the centre of the densest band of relative
+  // width 2·cruise_tolerance among the moving samples (robust to overshoot and noise spikes,
+  // which a median of the fast samples is not).
+  std::vector<double> moving_v;
   for (Eigen::Index k = 0; k < v.size(); ++k)
-    if (v[k] > 0.5 * peak) fast.push_back(v[k]);
-  s.velocity = median(fast);
+    if (v[k] > 0.1 * peak) moving_v.push_back(v[k]);
+  std::sort(moving_v.begin(), moving_v.end());
+  size_t best_i = 0, best_count = 0;
+  for (size_t i = 0, j = 0; i < moving_v.size(); ++i) {
+    if (j < i) j = i;
+    while (j + 1 < moving_v.size() &&
+           moving_v[j + 1] <= moving_v[i] * (1.0 + 2.0 * o.cruise_tolerance)) {
+      ++j;
+    }
+    if (j - i + 1 > best_count) {
+      best_count = j - i + 1;
+      best_i = i;
+    }
+  }
+  s.velocity = moving_v.empty() ? 0.0 : moving_v[best_i + best_count / 2];
   Eigen::Index moving = 0;
   for (Eigen::Index k = 0; k < v.size(); ++k) {
     if (v[k] > 0.1 * s.velocity) ++moving;

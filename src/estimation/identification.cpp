@@ -8,6 +8,7 @@
 
 #include "dynid/common/error.hpp"
 #include "dynid/estimation/cutoff_selection.hpp"
+#include "dynid/estimation/integral_equations.hpp"
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/outliers.hpp"
 #include "dynid/estimation/pipeline.hpp"
@@ -441,6 +442,17 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
   const int n = model.dof();
   IdentificationResult result;
   const bool coupling = options.coupling && !coupled_motors(model).empty();
+  const bool integral = options.model == IdentificationModel::kIntegral;
+  if (integral) {
+    std::ostringstream m;
+    m << "integral (energy) model, "
+      << (options.integral.long_integrals ? "long integrals from the first sample in steps of "
+                                          : "short intervals of ")
+      << options.integral.interval << " s";
+    result.choices.emplace_back("model", m.str());
+  } else {
+    result.choices.emplace_back("model", "differential (joint torques)");
+  }
   // prepare + equations, one run at a time (each its own rate, filter edges, derivatives).
   std::vector<EquationBlock> blocks;
   std::vector<ScreenedRun> screened;
@@ -448,15 +460,28 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
   for (size_t i = 0; i < runs.size(); ++i) {
     std::vector<std::pair<std::string, std::string>> choices;
     screened.push_back(screen_run(model, runs[i], options.outliers));  // outliers.hpp
-    // The cut-off of each run from its own data (held-out prediction, cutoff_selection.hpp).
-    const CutoffSelection cutoff = select_cutoff(model, screened.back().record, options);
-    ProcessedRecord processed =
-        preprocess_run(model, screened.back().record, cutoff.signal, choices);
-    echo_cutoff_selection(cutoff, choices);
-    hold_still_joints(model, processed, choices);
-    const Eigen::VectorXd threshold =
-        zero_velocity_threshold(options, processed, "removed", choices);
-    blocks.push_back(differential_equations(model, options.layout, coupling, processed, threshold));
+    ProcessedRecord processed;
+    Eigen::VectorXd threshold = Eigen::VectorXd::Zero(n);
+    if (integral) {
+      // The held-out cut-off selection fits the differential model; the integral model has its
+      // own fixed defaults (integral_signal_options()).
+      SignalOptions signal = options.signal;
+      if (signal.cutoff_hz <= 0.0) signal.cutoff_hz = integral_signal_options().cutoff_hz;
+      if (signal.decimate <= 0) signal.decimate = 1;
+      processed = preprocess_run(model, screened.back().record, signal, choices);
+      hold_still_joints(model, processed, choices);
+      blocks.push_back(
+          integral_equations(model, options.layout, coupling, processed, options.integral));
+    } else {
+      // The cut-off of each run from its own data (held-out prediction, cutoff_selection.hpp).
+      const CutoffSelection cutoff = select_cutoff(model, screened.back().record, options);
+      processed = preprocess_run(model, screened.back().record, cutoff.signal, choices);
+      echo_cutoff_selection(cutoff, choices);
+      hold_still_joints(model, processed, choices);
+      threshold = zero_velocity_threshold(options, processed, "removed", choices);
+      blocks.push_back(
+          differential_equations(model, options.layout, coupling, processed, threshold));
+    }
     RunSummary run;
     run.samples = processed.record.t.size();
     run.rows = blocks.back().y.size();

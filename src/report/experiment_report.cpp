@@ -139,6 +139,38 @@ nlohmann::json decoupled_model_to_json(const Model& model, const DecoupledJointR
   return out;
 }
 
+void physical_parameters_to_json(const PhysicalFit& fit, double relative_error,
+                                 double relative_error_unconstrained, nlohmann::json& result) {
+  nlohmann::json list = nlohmann::json::array();
+  for (size_t i = 0; i < fit.names.size(); ++i) {
+    list.push_back(
+        {{"name", fit.names[i]}, {"value", json_number(fit.theta[static_cast<Eigen::Index>(i)])}});
+  }
+  result["standard_parameters"] = list;
+  result["physically_consistent"] = fit.consistent;
+  result["physical"] = {
+      {"mahalanobis", json_number(fit.mahalanobis)},
+      {"chi2_limit", json_number(fit.chi2_limit)},
+      {"nominal_distance", json_number(fit.nominal_distance)},
+      {"converged", fit.converged},
+      {"iterations", fit.iterations},
+      {"relative_error", json_number(relative_error)},
+      {"relative_error_unconstrained", json_number(relative_error_unconstrained)},
+      {"min_pseudo_inertia_eigenvalue", numbers(fit.min_pseudo_inertia_eigenvalue)}};
+}
+
+std::string physical_parameters_text(const PhysicalFit& fit, double relative_error,
+                                     double relative_error_unconstrained) {
+  char buf[400];
+  std::snprintf(buf, sizeof(buf),
+                "physically consistent parameters: %s, %.3g sigma from the estimate (limit %.3g), "
+                "torque error %.2f %% against %.2f %% unconstrained%s\n",
+                fit.consistent ? "found" : "NOT found", fit.mahalanobis, fit.chi2_limit,
+                100.0 * relative_error, 100.0 * relative_error_unconstrained,
+                fit.converged ? "" : " (the fit stopped at its iteration limit)");
+  return buf;
+}
+
 std::string experiment_table(const nlohmann::json& result) {
   std::ostringstream s;
   char buf[256];

@@ -152,9 +152,17 @@ std::string identification_table(const Model& model, const IdentificationResult&
     }
   }
   const int w = name_width(model, 12);
-  for (int j = 0; j < model.dof(); ++j) {
-    s << line("  %-*s residual RMS %.4g, relative error %.2f %%\n", w, model.joints[j].name.c_str(),
-              r.residual_rms[j], 100 * r.joint_relative_error[j]);
+  if (r.residual_rms.size() == model.dof()) {
+    for (int j = 0; j < model.dof(); ++j) {
+      s << line("  %-*s residual RMS %.4g, relative error %.2f %%\n", w,
+                model.joints[j].name.c_str(), r.residual_rms[j], 100 * r.joint_relative_error[j]);
+    }
+  } else {
+    // The integral model's equations are one group of energy rows.
+    for (Eigen::Index g = 0; g < r.residual_rms.size(); ++g) {
+      s << line("  energy equations: residual RMS %.4g J, relative error %.2f %%\n",
+                r.residual_rms[g], 100 * r.joint_relative_error[g]);
+    }
   }
   for (const auto& w : r.warnings) s << "warning: " << one_line(w) << '\n';
   return s.str();

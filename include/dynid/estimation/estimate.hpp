@@ -9,8 +9,8 @@ namespace dynid {
 
 /// Which estimator produced an Estimate.
 enum class EstimatorKind {
-  kOrdinaryLeastSquares,  ///< QR least squares, one pass
-  kWeightedLeastSquares,  ///< Gautier's two-step weighted least squares (per-group variances)
+  kOrdinaryLeastSquares,   ///< QR least squares, one pass
+  kWeightedLeastSquares,   ///< Gautier's two-step weighted least squares (per-group variances)
   kRecursiveLeastSquares,  ///< U-D-Uᵀ recursive least squares (seed 1 eqs. 36–37)
   kMaximumLikelihood       ///< errors in variables (seed 2 eqs. 13–16)
 };

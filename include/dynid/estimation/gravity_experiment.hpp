@@ -16,7 +16,7 @@ struct GravityExperimentOptions {
   /// Two-sided level of the intervals, in (0, 1); 0.999 as seed 2 Table 3.
   double confidence_level = 0.999;
   /// A sample lies on a slope's cruise when |dq_J − v| ≤ cruise_tolerance·|v|, v the slope's
-  /// cruise velocity (median velocity of the samples moving faster than half the peak speed in
+  /// cruise velocity (the centre of the most populated velocity band of that relative width in
   /// that direction): there q̈ ≈ 0 and the velocity-dependent torque is constant.
   double cruise_tolerance = 0.05;
   /// A direction is a constant-velocity slope only if its cruise samples are at least this

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 
 #include "dynid/estimation/estimate.hpp"
+#include "dynid/estimation/integral_options.hpp"
 #include "dynid/estimation/outlier_options.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
 #include "dynid/model/model.hpp"
@@ -74,6 +75,12 @@ Eigen::VectorXd given_zero_velocity(const std::vector<double>& zero_velocity, in
 
 enum class IdentificationEstimator { kOls, kWls, kRls };
 
+/// Which equations identify() builds from each prepared run (DESIGN.md §8, "equations").
+enum class IdentificationModel {
+  kDifferential,  ///< τ = Y(q, q̇, q̈)·θ per joint and sample (seed 1 eq. 5, seed 2 eq. 9)
+  kIntegral       ///< ∫τᵀq̇ dt = ΔH·θ + friction work per interval (seed 1 eqs. 15–17)
+};
+
 /// Options of identify().
 struct IdentifyOptions {
   ParameterLayout layout = ParameterLayout::full();  ///< link + per-joint columns to identify
@@ -82,7 +89,13 @@ struct IdentifyOptions {
   double confidence_level = 0.999;  ///< Student-t interval level (seed 2 Table 3)
   /// Bartlett window (samples) of the HAC covariance behind std/ci_*; −1 = automatic (Andrews).
   int hac_bandwidth = -1;
-  SignalOptions signal;       ///< filtering, derivatives, decimation, sample removal
+  SignalOptions signal;  ///< filtering, derivatives, decimation, sample removal
+  /// The equations: differential (default) or integral. The integral model needs no q̈ and no
+  /// zero-velocity rule (|q̇| is continuous); an automatic cut-off becomes
+  /// integral_signal_options()'s 10 Hz and an automatic decimation 1 (the power is integrated at
+  /// the full rate).
+  IdentificationModel model = IdentificationModel::kDifferential;
+  IntegralOptions integral;   ///< intervals and quadrature of the integral model
   BaseParameterOptions base;  ///< base-parameter computation (layout is overwritten)
   OutlierOptions outliers;    ///< gross torque outliers: report or drop (outliers.hpp)
   /// With the RLS estimator: keep the estimate and σ after every equation (history_* of the

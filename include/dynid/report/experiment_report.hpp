@@ -7,6 +7,7 @@
 #include "dynid/estimation/decoupled_model.hpp"
 #include "dynid/estimation/friction_experiment.hpp"
 #include "dynid/estimation/gravity_experiment.hpp"
+#include "dynid/estimation/physical_parameters.hpp"
 #include "dynid/model/model.hpp"
 
 namespace dynid {
@@ -27,6 +28,16 @@ nlohmann::json friction_experiment_to_json(const Model& model, const FrictionExp
 /// k<J>, qoff<J>, Fvp<J> Fvn<J> Fcp<J> Fcn<J>, `held_span` and `coupling_ratio` per joint.
 nlohmann::json decoupled_model_to_json(const Model& model, const DecoupledJointResult& r,
                                        const nlohmann::json& options_used);
+
+/// Adds the physically consistent fit to an identify result JSON: `standard_parameters` (name,
+/// value), `physically_consistent` and `physical` (mahalanobis, chi2_limit, nominal_distance,
+/// converged, relative_error of the consistent set and relative_error_unconstrained).
+void physical_parameters_to_json(const PhysicalFit& fit, double relative_error,
+                                 double relative_error_unconstrained, nlohmann::json& result);
+
+/// Two lines for the terminal: how far the consistent set is and what it costs in torque error.
+std::string physical_parameters_text(const PhysicalFit& fit, double relative_error,
+                                     double relative_error_unconstrained);
 
 /// The `parameters` of one of these JSON results as a table for the terminal, with its warnings.
 std::string experiment_table(const nlohmann::json& result);
