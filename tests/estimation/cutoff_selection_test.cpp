@@ -20,32 +20,20 @@
 #include "dynid/model/robots.hpp"
 #include "dynid/sim/simulate_reference.hpp"
 #include "dynid/workflow/demo.hpp"
+#include "support/closed_loop_runs.hpp"
 
 namespace dynid {
 namespace {
 
 Model plant_model() {
-  Model m = load_robot("planar2");
-  m.joints[0].friction.Fv = 1.5;
-  m.joints[0].friction.Fc = 2.0;
-  m.joints[0].friction.Fo = 0.3;
-  m.joints[1].friction.Fv = 0.8;
-  m.joints[1].friction.Fc = 1.0;
-  m.joints[1].friction.Fo = -0.2;
-  return m;
+  return testing::planar2_with_friction();
 }
 
 // Six periods of a 0.2 Hz, 4-harmonic reference at 100 Hz under the PID, encoder noise fed back;
 // the first (start-up) period is dropped. `other` gives the validation reference.
 JointRecord closed_loop_run(const Model& m, bool other, double noise, unsigned seed) {
-  FourierCoefficients c = FourierCoefficients::zeros({4, 4}, 0.2);
-  if (!other) {
-    c.a[0] << 0.8, 0.3, -0.2, 0.1;
-    c.b[0] << 0.2, -0.3, 0.1, 0.05;
-    c.a[1] << -0.6, 0.4, 0.2, -0.1;
-    c.b[1] << 0.3, 0.2, -0.2, 0.1;
-    c.q0 = Eigen::Vector2d(-0.5, 0.8);
-  } else {
+  FourierCoefficients c = testing::planar2_reference();
+  if (other) {
     c.a[0] << -0.5, 0.4, 0.15, -0.1;
     c.b[0] << 0.4, 0.2, -0.15, 0.05;
     c.a[1] << 0.7, -0.2, 0.1, 0.1;
@@ -54,14 +42,7 @@ JointRecord closed_loop_run(const Model& m, bool other, double noise, unsigned s
   }
   const double rate = 100.0;
   const TrajectorySamples tr = sample_trajectory(FourierTrajectory(c), rate, false);
-  SimulateOptions so;
-  so.sensors.position_noise_std = noise;
-  so.sensors.torque_noise_std = 0.05;
-  so.sensors.seed = seed;
-  so.loop.periods = 6;
-  const ClosedLoopResult run = simulate_reference(m, tr.t, tr.q, tr.dq, tr.ddq, so);
-  const Eigen::Index skip = static_cast<Eigen::Index>(5 * rate), rows = run.t.size() - skip;
-  return {run.t.tail(rows), run.q.bottomRows(rows), {}, {}, run.tau.bottomRows(rows)};
+  return testing::closed_loop_run(m, tr, testing::noisy_sensors(noise, 0.05, seed, 6));
 }
 
 struct Sweep {

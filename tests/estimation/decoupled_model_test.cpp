@@ -16,6 +16,7 @@
 #include "dynid/excitation/trajectory_samples.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/sim/simulate_reference.hpp"
+#include "support/closed_loop_runs.hpp"
 
 namespace dynid {
 namespace {
@@ -39,18 +40,8 @@ ProcessedRecord run(const Model& m, int moving, const Eigen::Vector2d& pose, uns
   if (also >= 0) c.a[also] << 0.3, 0.1, 0.0;
   c.q0 = pose;
   const TrajectorySamples tr = sample_trajectory(FourierTrajectory(c), kRate, false);
-  SimulateOptions so;
-  so.sensors.position_noise_std = 1e-4;
-  so.sensors.torque_noise_std = 0.05;
-  so.sensors.seed = seed;
-  so.loop.periods = 4;
-  const ClosedLoopResult r = simulate_reference(m, tr.t, tr.q, tr.dq, tr.ddq, so);
-  const Eigen::Index skip = tr.t.size(), rows = r.t.size() - skip;
-  const JointRecord record{r.t.tail(rows), r.q.bottomRows(rows), {}, {}, r.tau.bottomRows(rows)};
-  std::vector<std::pair<std::string, std::string>> choices;
-  SignalOptions signal;
-  signal.torque_time_offset = 0.5 / kRate;
-  return preprocess(record, signal, choices);
+  return testing::prepared(
+      testing::closed_loop_run(m, tr, testing::noisy_sensors(1e-4, 0.05, seed, 4)), kRate);
 }
 
 TEST(DecoupledModel, RecoversInertiaGravityAndFrictionOfEachJoint) {

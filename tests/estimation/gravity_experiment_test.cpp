@@ -15,6 +15,7 @@
 #include "dynid/excitation/trajectory_samples.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/sim/simulate_reference.hpp"
+#include "support/closed_loop_runs.hpp"
 
 namespace dynid {
 namespace {
@@ -60,19 +61,8 @@ std::pair<double, double> same_side(double k, double q_off, double q_off_truth) 
 }
 
 ProcessedRecord prepared(const Model& m, const TrajectorySamples& tr, unsigned seed) {
-  SimulateOptions so;
-  so.sensors.position_noise_std = 1e-4;
-  so.sensors.torque_noise_std = 0.05;
-  so.sensors.seed = seed;
-  so.loop.periods = 3;
-  const ClosedLoopResult run = simulate_reference(m, tr.t, tr.q, tr.dq, tr.ddq, so);
-  const Eigen::Index skip = tr.t.size(), rows = run.t.size() - skip;  // start-up period
-  const JointRecord record{
-      run.t.tail(rows), run.q.bottomRows(rows), {}, {}, run.tau.bottomRows(rows)};
-  std::vector<std::pair<std::string, std::string>> choices;
-  SignalOptions signal;
-  signal.torque_time_offset = 0.5 / kRate;  // the logged command is held over the next step
-  return preprocess(record, signal, choices);
+  return testing::prepared(
+      testing::closed_loop_run(m, tr, testing::noisy_sensors(1e-4, 0.05, seed, 3)), kRate);
 }
 
 TrajectorySamples slopes(int joint, const Eigen::Vector2d& pose, double velocity) {

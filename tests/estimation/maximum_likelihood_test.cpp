@@ -19,6 +19,7 @@
 #include "dynid/identifiability/base_parameters.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/sim/simulate_reference.hpp"
+#include "support/closed_loop_runs.hpp"
 
 namespace dynid {
 namespace {
@@ -102,13 +103,8 @@ constexpr double kRate = 100.0;
 // A closed-loop run of the plant without sensor noise; the true q, q̇, q̈, τ are then measured with
 // independent white noise of the given sizes.
 MeasuredRun measured_run(const Model& m, const MeasurementNoise& noise, unsigned seed) {
-  FourierCoefficients c = FourierCoefficients::zeros({4, 4}, 0.2);
-  c.a[0] << 0.8, 0.3, -0.2, 0.1;
-  c.b[0] << 0.2, -0.3, 0.1, 0.05;
-  c.a[1] << -0.6, 0.4, 0.2, -0.1;
-  c.b[1] << 0.3, 0.2, -0.2, 0.1;
-  c.q0 = Eigen::Vector2d(-0.5, 0.8);
-  const TrajectorySamples tr = sample_trajectory(FourierTrajectory(c), kRate, false);
+  const TrajectorySamples tr =
+      sample_trajectory(FourierTrajectory(testing::planar2_reference()), kRate, false);
   SimulateOptions so;
   so.loop.periods = 3;
   so.loop.record_truth = true;

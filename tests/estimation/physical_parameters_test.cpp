@@ -19,6 +19,7 @@
 #include "dynid/model/robots.hpp"
 #include "dynid/model/transmission.hpp"
 #include "dynid/sim/simulate_reference.hpp"
+#include "support/closed_loop_runs.hpp"
 
 namespace dynid {
 namespace {
@@ -46,23 +47,11 @@ namespace {
 }
 
 IdentificationResult planar2_result(const Model& m, unsigned seed) {
-  FourierCoefficients c = FourierCoefficients::zeros({4, 4}, 0.2);
-  c.a[0] << 0.8, 0.3, -0.2, 0.1;
-  c.b[0] << 0.2, -0.3, 0.1, 0.05;
-  c.a[1] << -0.6, 0.4, 0.2, -0.1;
-  c.b[1] << 0.3, 0.2, -0.2, 0.1;
-  c.q0 = Eigen::Vector2d(-0.5, 0.8);
-  const TrajectorySamples tr = sample_trajectory(FourierTrajectory(c), 100.0, false);
-  SimulateOptions so;
-  so.sensors.position_noise_std = 1e-4;
-  so.sensors.torque_noise_std = 0.05;
-  so.sensors.seed = seed;
-  so.loop.periods = 4;
-  const ClosedLoopResult run = simulate_reference(m, tr.t, tr.q, tr.dq, tr.ddq, so);
-  const Eigen::Index skip = tr.t.size(), rows = run.t.size() - skip;
+  const TrajectorySamples tr =
+      sample_trajectory(FourierTrajectory(testing::planar2_reference()), 100.0, false);
   IdentifyOptions o;
   o.signal.torque_time_offset = 0.005;
-  return identify(m, {run.t.tail(rows), run.q.bottomRows(rows), {}, {}, run.tau.bottomRows(rows)},
+  return identify(m, testing::closed_loop_run(m, tr, testing::noisy_sensors(1e-4, 0.05, seed, 4)),
                   o);
 }
 

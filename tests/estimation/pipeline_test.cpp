@@ -17,6 +17,7 @@
 #include "dynid/model/robots.hpp"
 #include "dynid/sim/simulate_reference.hpp"
 #include "estimation_support.hpp"
+#include "support/closed_loop_runs.hpp"
 
 namespace dynid {
 namespace {
@@ -40,14 +41,7 @@ JointRecord closed_loop_run(const Model& m, const Eigen::VectorXd& q0,
   }
   c.q0 = q0;
   const TrajectorySamples tr = sample_trajectory(FourierTrajectory(c), kRate, false);
-  SimulateOptions so;
-  so.sensors.position_noise_std = 1e-5;
-  so.sensors.torque_noise_std = 0.05;
-  so.sensors.seed = seed;
-  so.loop.periods = 6;
-  const ClosedLoopResult run = simulate_reference(m, tr.t, tr.q, tr.dq, tr.ddq, so);
-  const Eigen::Index skip = static_cast<Eigen::Index>(5 * kRate), rows = run.t.size() - skip;
-  return {run.t.tail(rows), run.q.bottomRows(rows), {}, {}, run.tau.bottomRows(rows)};
+  return testing::closed_loop_run(m, tr, testing::noisy_sensors(1e-5, 0.05, seed, 6));
 }
 
 // simulate_reference logs the command it then holds for one period.
@@ -58,14 +52,7 @@ IdentifyOptions held_torque() {
 }
 
 Model friction_planar2() {
-  Model m = load_robot("planar2");
-  m.joints[0].friction.Fv = 1.5;
-  m.joints[0].friction.Fc = 2.0;
-  m.joints[0].friction.Fo = 0.3;
-  m.joints[1].friction.Fv = 0.8;
-  m.joints[1].friction.Fc = 1.0;
-  m.joints[1].friction.Fo = -0.2;
-  return m;
+  return testing::planar2_with_friction();
 }
 
 // The true base-parameter value of each estimated name (coupled-motor columns are zero in truth).
