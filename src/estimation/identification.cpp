@@ -235,6 +235,8 @@ ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& option
   out.record.tau = take_rows(r.tau, first, last, decimate);
   out.rate_hz = rate / decimate;
   out.cutoff_hz = options.filter ? cutoff : 0.0;
+  out.trim = trim;
+  out.decimate = decimate;
   out.position_noise_std =
       floor.noise_std.unaryExpr([](double v) { return std::isfinite(v) ? v : 0.0; });
   out.velocity_noise_std = out_noise_gain * out.position_noise_std;

@@ -191,10 +191,8 @@ PreparedLoadRun prepare_load_run(const JointRecord& record,
   // decimation: the same filter, edges and rows, without a second copy of the processing.
   SignalOptions same = options;
   same.cutoff_hz = processed.cutoff_hz;
-  for (const auto& [key, value] : choices) {
-    if (key == "trim") same.trim = std::stoi(value);
-    if (key == "decimate") same.decimate = std::stoi(value);
-  }
+  same.trim = processed.trim;
+  same.decimate = processed.decimate;
   JointRecord force;
   force.t = record.t;
   force.q = wrench;

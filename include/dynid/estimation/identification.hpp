@@ -132,6 +132,8 @@ struct ProcessedRecord {
   /// filtered like tau, trimmed and decimated like `record` (m × n each); else empty.
   Eigen::MatrixXd moving_positive, moving_negative;
   double cutoff_hz = 0.0;  ///< low-pass cut-off used [Hz]; 0 without filter
+  int trim = 0;            ///< samples dropped at each end after filtering (resolved)
+  int decimate = 1;        ///< every decimate-th sample kept (resolved)
   /// Per joint, std of the white position noise floor of the input (position_noise_floor) and of
   /// the resulting noise on the processed velocity [rad/s or m/s]; 0 when not measurable.
   Eigen::VectorXd position_noise_std, velocity_noise_std;
