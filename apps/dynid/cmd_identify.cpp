@@ -423,11 +423,11 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   const Model model = load_robot(o.robot);
   RunFileReport read;
   IdentificationResult result;
+  std::vector<JointRecord> records;
   if (o.stream) {
     result = identify_stream(model, o.data, file, options, {o.threads, true});
   } else {
     // Each run read on its own (same column mapping, window and torque scale for every run).
-    std::vector<JointRecord> records;
     for (const auto& run : o.runs) records.push_back(read_joint_record(run, model, file, &read));
     result = identify(model, records, options);
     for (size_t i = 0; i < result.runs.size(); ++i) result.runs[i].file = o.runs[i];
@@ -451,8 +451,10 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     }
     const PhysicalFit fit = physical_parameters(model, result.base, options.layout,
                                                 result.estimate.x, result.estimate.covariance);
-    // The torque error of the consistent set beside the unconstrained one, on the first run.
-    const JointRecord first = read_joint_record(o.runs.front(), model, file, nullptr);
+    // The torque error of the consistent set beside the unconstrained one, on the first run
+    // (read here only in the streaming mode, which keeps no run in memory).
+    if (records.empty()) records.push_back(read_joint_record(o.runs.front(), model, file));
+    const JointRecord& first = records.front();
     IdentifyOptions same = options;
     same.signal.cutoff_hz = result.processed.cutoff_hz;
     const double physical_error =
