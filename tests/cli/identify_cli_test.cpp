@@ -9,6 +9,8 @@
 #include <sstream>
 #include <string>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -21,8 +23,10 @@ struct CliRun {
 };
 
 CliRun run(const std::string& args) {
-  const std::string err_path = ::testing::TempDir() + "/identify_cli_err.txt";
-  const std::string out_path = ::testing::TempDir() + "/identify_cli_out.txt";
+  // Named after this process: ctest runs the test cases as parallel processes.
+  const std::string pid = std::to_string(::getpid());
+  const std::string err_path = ::testing::TempDir() + "/identify_cli_err." + pid + ".txt";
+  const std::string out_path = ::testing::TempDir() + "/identify_cli_out." + pid + ".txt";
   const std::string cmd =
       std::string(DYNID_BINARY) + " " + args + " > " + out_path + " 2> " + err_path;
   const int status = std::system(cmd.c_str());

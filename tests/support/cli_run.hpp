@@ -3,6 +3,7 @@
 // Runs the built dynid binary (compile definition DYNID_BINARY) for the CLI tests.
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -28,9 +29,12 @@ inline std::string slurp(const std::filesystem::path& path) {
 }
 
 /// Runs `dynid <args>` (shell words; paths without spaces) with stdin from /dev/null; stdout and
-/// stderr go through files in `scratch`, which must exist.
+/// stderr go through files in `scratch`, which must exist, named after this process: ctest runs
+/// test cases as parallel processes, which share a scratch folder.
 inline CliResult run_dynid(const std::string& args, const std::filesystem::path& scratch) {
-  const std::filesystem::path out = scratch / "stdout.txt", err = scratch / "stderr.txt";
+  const std::string pid = std::to_string(::getpid());
+  const std::filesystem::path out = scratch / ("stdout." + pid + ".txt"),
+                              err = scratch / ("stderr." + pid + ".txt");
   const std::string command = std::string("'") + DYNID_BINARY + "' " + args + " >'" + out.string() +
                               "' 2>'" + err.string() + "' </dev/null";
   const int status = std::system(command.c_str());
