@@ -493,55 +493,38 @@ LoadIdentificationResult identify_load(const EquationBlock& block,
   return out;
 }
 
-LoadIdentificationResult identify_load_from_torques(const Model& model, int link,
-                                                    const LoadFrame& frame,
-                                                    const ParameterLayout& layout,
-                                                    const JointRecord& loaded,
-                                                    const JointRecord& unloaded,
-                                                    const LoadIdentificationOptions& options) {
+namespace {
+
+// The ten load columns of the joint-torque equations of `record` (sample-major, (m·n)×10 in load
+// order m mcx … Izz): the load enters like link `link`'s own standard parameters, Y_link·T, where
+// T maps the load's parameters about F to those about the link origin (transform_link_params).
+Eigen::MatrixXd load_link_columns(const Model& model, int link, const LoadFrame& frame,
+                                  const JointRecord& record) {
   const int n = model.dof();
   if (link < 0 || link >= n) {
     throw Error("load link index " + std::to_string(link) + " is outside 0.." +
                 std::to_string(n - 1));
   }
-  const Eigen::MatrixXd Y_loaded = stacked_regressor(model, layout, false, loaded);
-  const Eigen::MatrixXd Y_unloaded = stacked_regressor(model, layout, false, unloaded);
-  const Eigen::Index p = Y_loaded.cols(), rows_l = Y_loaded.rows(), rows_u = Y_unloaded.rows();
-  // T: load parameters about F (link order) → about the link origin; column k = T·e_k.
+  const Eigen::MatrixXd Y = stacked_regressor(model, ParameterLayout::rigid(), false, record);
   Eigen::Matrix<double, kLinkParams, kLinkParams> T;
   for (int k = 0; k < kLinkParams; ++k) {
     T.col(k) = transform_link_params(LinkParams::Unit(k), frame.R_LF, frame.p_LF);
   }
   // Load order m mcx mcy mcz Ixx … Izz = link order indices M MX MY MZ XX … ZZ.
   const int kFromLinkOrder[kLinkParams] = {9, 6, 7, 8, 0, 1, 2, 3, 4, 5};
-  const Eigen::MatrixXd load_link = Y_loaded.middleCols(kLinkParams * link, kLinkParams) * T;
-  EquationBlock block;
-  block.W.setZero(rows_l + rows_u, p + kLinkParams);
-  block.W.topLeftCorner(rows_l, p) = Y_loaded;
-  block.W.bottomLeftCorner(rows_u, p) = Y_unloaded;
-  for (int k = 0; k < kLinkParams; ++k) {
-    block.W.block(0, p + k, rows_l, 1) = load_link.col(kFromLinkOrder[k]);
-  }
-  block.y.resize(rows_l + rows_u);
-  for (Eigen::Index k = 0; k < loaded.tau.rows(); ++k) {
-    block.y.segment(k * n, n) = loaded.tau.row(k).transpose();
-  }
-  for (Eigen::Index k = 0; k < unloaded.tau.rows(); ++k) {
-    block.y.segment(rows_l + k * n, n) = unloaded.tau.row(k).transpose();
-  }
-  block.group = joint_row_groups(rows_l + rows_u, n);
-  block.sample.resize(rows_l + rows_u);
-  for (Eigen::Index i = 0; i < rows_l + rows_u; ++i) {
-    block.sample(i) = static_cast<int>(i < rows_l ? i / n : loaded.tau.rows() + (i - rows_l) / n);
-  }
-  block.columns = layout.names(n);
-  for (const auto& name : load_parameter_names({})) block.columns.push_back("load_" + name);
-  LoadIdentificationOptions batch = options;
-  batch.record_history = false;
-  const Estimate full = estimate_block(block, batch, nullptr);
+  const Eigen::MatrixXd link_columns = Y.middleCols(kLinkParams * link, kLinkParams) * T;
+  Eigen::MatrixXd out(Y.rows(), kLinkParams);
+  for (int k = 0; k < kLinkParams; ++k) out.col(k) = link_columns.col(kFromLinkOrder[k]);
+  return out;
+}
+
+// The load's part of an estimate whose last ten columns are the load's (first = their index):
+// parameters the joint torques do not determine get infinite σ and are listed; the mass checks
+// and the physical reading apply to what is determined.
+LoadIdentificationResult load_result_from_torques(const Estimate& full, Eigen::Index first) {
   LoadIdentificationResult out;
   out.names = load_parameter_names({});
-  out.estimate = slice(full, p, kLinkParams);
+  out.estimate = slice(full, first, kLinkParams);
   std::vector<bool> undetermined(kLinkParams, false);
   for (const Eigen::Index j : out.estimate.unidentifiable) {
     undetermined[static_cast<std::size_t>(j)] = true;
@@ -559,6 +542,98 @@ LoadIdentificationResult identify_load_from_torques(const Model& model, int link
     out.physics.violated = "not every parameter is determined by the joint torques";
   }
   return out;
+}
+
+}  // namespace
+
+LoadIdentificationResult identify_load_from_torques(const Model& model, int link,
+                                                    const LoadFrame& frame,
+                                                    const ParameterLayout& layout,
+                                                    const JointRecord& loaded,
+                                                    const JointRecord& unloaded,
+                                                    const LoadIdentificationOptions& options) {
+  const int n = model.dof();
+  const Eigen::MatrixXd load = load_link_columns(model, link, frame, loaded);
+  const Eigen::MatrixXd Y_loaded = stacked_regressor(model, layout, false, loaded);
+  const Eigen::MatrixXd Y_unloaded = stacked_regressor(model, layout, false, unloaded);
+  const Eigen::Index p = Y_loaded.cols(), rows_l = Y_loaded.rows(), rows_u = Y_unloaded.rows();
+  EquationBlock block;
+  block.W.setZero(rows_l + rows_u, p + kLinkParams);
+  block.W.topLeftCorner(rows_l, p) = Y_loaded;
+  block.W.bottomLeftCorner(rows_u, p) = Y_unloaded;
+  block.W.topRightCorner(rows_l, kLinkParams) = load;
+  block.y.resize(rows_l + rows_u);
+  for (Eigen::Index k = 0; k < loaded.tau.rows(); ++k) {
+    block.y.segment(k * n, n) = loaded.tau.row(k).transpose();
+  }
+  for (Eigen::Index k = 0; k < unloaded.tau.rows(); ++k) {
+    block.y.segment(rows_l + k * n, n) = unloaded.tau.row(k).transpose();
+  }
+  block.group = joint_row_groups(rows_l + rows_u, n);
+  block.sample.resize(rows_l + rows_u);
+  for (Eigen::Index i = 0; i < rows_l + rows_u; ++i) {
+    block.sample(i) = static_cast<int>(i < rows_l ? i / n : loaded.tau.rows() + (i - rows_l) / n);
+  }
+  block.columns = layout.names(n);
+  for (const auto& name : load_parameter_names({})) block.columns.push_back("load_" + name);
+  LoadIdentificationOptions batch = options;
+  batch.record_history = false;
+  return load_result_from_torques(estimate_block(block, batch, nullptr), p);
+}
+
+LoadIdentificationResult identify_load_from_unexplained_torques(
+    const Model& model, int link, const LoadFrame& frame, const JointRecord& loaded,
+    const Eigen::Ref<const Eigen::MatrixXd>& predicted,
+    const Eigen::Ref<const Eigen::VectorXd>& zero_velocity_threshold,
+    const LoadIdentificationOptions& options) {
+  const int n = model.dof();
+  const Eigen::Index m = loaded.t.size();
+  check_rows(loaded.q, m, n, "q");
+  check_rows(loaded.dq, m, n, "dq");
+  check_rows(loaded.ddq, m, n, "ddq");
+  check_rows(loaded.tau, m, n, "tau");
+  check_rows(predicted, m, n, "the predicted torque");
+  if (zero_velocity_threshold.size() != 0 && zero_velocity_threshold.size() != n) {
+    throw Error("the zero-velocity thresholds have " +
+                std::to_string(zero_velocity_threshold.size()) + " values for " +
+                std::to_string(n) + " joints; give one per joint or none");
+  }
+  const Eigen::MatrixXd load = load_link_columns(model, link, frame, loaded);
+  // The rows identify() fits: near-still rows of a Coulomb model carry sign(dq) noise in the
+  // prediction, so they are left out here as they were there.
+  std::vector<Eigen::Index> rows;
+  for (Eigen::Index k = 0; k < m; ++k) {
+    for (int j = 0; j < n; ++j) {
+      if (zero_velocity_threshold.size() == 0 ||
+          std::abs(loaded.dq(k, j)) >= zero_velocity_threshold(j)) {
+        rows.push_back(k * n + j);
+      }
+    }
+  }
+  EquationBlock block;
+  const auto used = static_cast<Eigen::Index>(rows.size());
+  block.W.resize(used, kLinkParams);
+  block.y.resize(used);
+  block.group.resize(used);
+  block.sample.resize(used);
+  for (Eigen::Index i = 0; i < used; ++i) {
+    const Eigen::Index row = rows[static_cast<std::size_t>(i)], k = row / n;
+    const int j = static_cast<int>(row % n);
+    block.W.row(i) = load.row(row);
+    block.y(i) = loaded.tau(k, j) - predicted(k, j);
+    block.group(i) = j;
+    block.sample(i) = static_cast<int>(k);
+  }
+  block.columns = load_parameter_names({});
+  for (int j = 0; j < n; ++j) block.group_names.push_back(model.joints[j].name);
+  if (!block.y.allFinite() || !block.W.allFinite()) {
+    throw Error(
+        "the loaded run or the predicted torques are not finite; check the run's torque "
+        "columns and the reference result's parameter values");
+  }
+  LoadIdentificationOptions batch = options;
+  batch.record_history = false;
+  return load_result_from_torques(estimate_block(block, batch, nullptr), 0);
 }
 
 }  // namespace dynid

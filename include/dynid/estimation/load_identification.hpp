@@ -196,4 +196,20 @@ LoadIdentificationResult identify_load_from_torques(const Model& model, int link
                                                     const JointRecord& unloaded,
                                                     const LoadIdentificationOptions& options);
 
+/// A load on link `link` from the torque an identified model of the unloaded robot does not
+/// explain (issue 12 item 3, a `dynid identify` result as reference): τ_loaded − τ̂ = Y_link·T·Φ_F,
+/// with τ̂ the model's prediction on the loaded run (validate_torques()'s `predicted` on the same
+/// processed record). Only the ten load columns are fitted; the reference's own uncertainty is not
+/// propagated (its σ is small when it was identified on a long run; docs/methods/load.md). Rows
+/// with |q̇_j| below zero_velocity_threshold(j) are left out as identify() left them out (empty:
+/// every row). loaded: processed record (t, q, dq, ddq, tau; m×n); predicted: m×n [N·m or N].
+/// Parameters the torques do not determine are in not_excited with σ = +inf. Throws
+/// dynid::Error for sizes, non-finite values, a link out of range, fewer rows than columns; as
+/// identify_load for the mass (when determined).
+LoadIdentificationResult identify_load_from_unexplained_torques(
+    const Model& model, int link, const LoadFrame& frame, const JointRecord& loaded,
+    const Eigen::Ref<const Eigen::MatrixXd>& predicted,
+    const Eigen::Ref<const Eigen::VectorXd>& zero_velocity_threshold,
+    const LoadIdentificationOptions& options);
+
 }  // namespace dynid
