@@ -1,6 +1,7 @@
 // `dynid simulate`: run a reference trajectory in closed loop on a simulated robot.
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "commands.hpp"
@@ -8,8 +9,10 @@
 #include "dynid/io/csv_writer.hpp"
 #include "dynid/io/joint_record_file.hpp"
 #include "dynid/model/robots.hpp"
+#include "dynid/sim/load_sensor.hpp"
 #include "dynid/sim/pid_gains.hpp"
 #include "dynid/sim/simulate_reference.hpp"
+#include "flag_checks.hpp"
 
 namespace dynid::cli {
 namespace {
@@ -20,6 +23,9 @@ struct SimulateCliOptions {
   unsigned seed = 1;
   double position_noise = 0.0, torque_noise = 0.0, counts_per_rev = 0.0;
   bool truth = false;
+  // A load behind a wrist force/torque sensor (issue 12 item 4).
+  std::string payload, payload_link, sensor_pose;
+  std::vector<double> wrench_noise;
 };
 
 // The gains file written next to the run: run.csv -> run.gains.json (docs/cli.md).
@@ -28,6 +34,33 @@ std::string gains_file_for(const std::string& out) {
   const bool csv = out.size() > suffix.size() &&
                    out.compare(out.size() - suffix.size(), suffix.size(), suffix) == 0;
   return (csv ? out.substr(0, out.size() - suffix.size()) : out) + ".gains.json";
+}
+
+// The load of --payload on --payload-link at --sensor-pose, or none; usage errors name the flag.
+std::optional<MountedLoad> payload_options(const SimulateCliOptions& o, const Model& model) {
+  if (o.payload.empty()) {
+    if (!o.payload_link.empty() || !o.sensor_pose.empty() || !o.wrench_noise.empty()) {
+      throw UsageError("--payload-link, --sensor-pose and --wrench-noise need --payload load.yaml");
+    }
+    return std::nullopt;
+  }
+  if (o.payload_link.empty()) {
+    throw UsageError("--payload needs --payload-link LINK: the link that carries the sensor");
+  }
+  if (o.wrench_noise.size() > 2) {
+    throw UsageError("--wrench-noise takes one std for all six components or two: FORCE,MOMENT");
+  }
+  MountedLoad load;
+  load.mount.link = find_link(model, o.payload_link);
+  if (!o.sensor_pose.empty()) {
+    const std::vector<double> pose =
+        flag_numbers(o.sensor_pose, 6, "--sensor-pose",
+                     "\"x y z roll pitch yaw\" [m, rad] of the sensor in the link frame");
+    load.mount.p_LS = Eigen::Vector3d(pose[0], pose[1], pose[2]);
+    load.mount.R_LS = roll_pitch_yaw(pose[3], pose[4], pose[5]);
+  }
+  load.phi = read_load_file(o.payload);
+  return load;
 }
 
 void run(const SimulateCliOptions& o) {
@@ -39,6 +72,7 @@ void run(const SimulateCliOptions& o) {
   }
   if (o.periods < 1) throw UsageError("--periods must be >= 1");
   const Model model = load_robot(o.robot);
+  const std::optional<MountedLoad> load = payload_options(o, model);
   const JointRecord ref = read_reference(o.trajectory, model);
   SimulateOptions s;
   s.feed_forward = o.controller == "pid" ? FeedForward::kNone : FeedForward::kComputedTorque;
@@ -50,20 +84,28 @@ void run(const SimulateCliOptions& o) {
   s.sensors.position_delay = s.sensors.torque_delay = o.delay;
   s.sensors.seed = o.seed;
   s.loop.periods = o.periods;
-  s.loop.record_truth = o.truth;
+  s.loop.record_truth = o.truth || load.has_value();  // the wrench follows the true motion
   PidOptions pid;
-  const ClosedLoopResult r = simulate_reference(model, ref.t, ref.q, ref.dq, ref.ddq, s, &pid);
+  const ClosedLoopResult r = simulate_reference(load ? model_with_load(model, *load) : model, ref.t,
+                                                ref.q, ref.dq, ref.ddq, s, &pid);
   const Eigen::Index n = model.dof();
   std::vector<std::string> cols = {"t"};
   std::vector<const char*> prefixes = {"qr", "q", "tau"};
   if (o.truth) prefixes.insert(prefixes.end(), {"dq", "ddq"});
   for (const char* p : prefixes)
     for (Eigen::Index j = 0; j < n; ++j) cols.push_back(p + std::to_string(j + 1));
+  if (load) cols.insert(cols.end(), {"fx", "fy", "fz", "mx", "my", "mz"});
   Eigen::MatrixXd data(r.t.size(), static_cast<Eigen::Index>(cols.size()));
   if (o.truth) {
-    data << r.t, r.qr, r.q, r.tau, r.dq_true, r.ddq_true;
+    data.leftCols(1 + 5 * n) << r.t, r.qr, r.q, r.tau, r.dq_true, r.ddq_true;
   } else {
-    data << r.t, r.qr, r.q, r.tau;
+    data.leftCols(1 + 3 * n) << r.t, r.qr, r.q, r.tau;
+  }
+  if (load) {
+    Eigen::MatrixXd wrench = load_sensor_wrench(model, *load, r.q_true, r.dq_true, r.ddq_true);
+    add_wrench_noise(wrench, o.wrench_noise.empty() ? 0.0 : o.wrench_noise[0],
+                     o.wrench_noise.empty() ? 0.0 : o.wrench_noise.back(), o.seed + 1);
+    data.rightCols(6) = wrench;
   }
   const std::string gains_path = gains_file_for(o.out);
   write_csv(o.out, cols, data);
@@ -105,6 +147,19 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--counts-per-rev", o->counts_per_rev,
                   "Encoder counts per revolution; 0 = exact");
   cmd->add_option("--delay", o->delay, "Measurement delay [samples]");
+  cmd->add_option("--payload", o->payload,
+                  "Load file (YAML: mass, com, inertia_com in the sensor frame, docs/cli.md) of a "
+                  "rigid load behind a wrist force/torque sensor; adds fx fy fz mx my mz, what "
+                  "the sensor reads (force and moment of the load on it, sensor frame), to --out");
+  cmd->add_option("--payload-link", o->payload_link,
+                  "With --payload: link (or joint) name that carries the sensor");
+  cmd->add_option("--sensor-pose", o->sensor_pose,
+                  "With --payload: \"x y z roll pitch yaw\" of the sensor frame in the link "
+                  "frame [m, rad], URDF roll-pitch-yaw convention; default: the link frame");
+  cmd->add_option("--wrench-noise", o->wrench_noise,
+                  "With --payload: Gaussian noise std on the wrench, FORCE[,MOMENT] [N, N m] "
+                  "(one value: the same on all six); seeded by --seed")
+      ->delimiter(',');
   cmd->add_flag("--truth", o->truth,
                 "Also write the true dq*, ddq* (real robots rarely measure them)");
   cmd->callback([o] { run(*o); });

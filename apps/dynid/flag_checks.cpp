@@ -2,8 +2,11 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <sstream>
 #include <string>
 #include <vector>
+
+#include "dynid/common/error.hpp"
 
 namespace dynid::cli {
 namespace {
@@ -24,6 +27,7 @@ const SignRule kSignRules[] = {
     {"identify", "--rate", Sign::kNonNegative},
     {"identify", "--zero-velocity", Sign::kNonNegative},
     {"identify", "--threads", Sign::kNonNegative},
+    {"simulate", "--wrench-noise", Sign::kNonNegative},
     {"validate", "--cutoff", Sign::kNonNegative},
     {"validate", "--rate", Sign::kNonNegative},
     {"validate", "--zero-velocity", Sign::kNonNegative},
@@ -95,6 +99,28 @@ void check_numeric_flags(CLI::App& app) {
         },
         "", sign == Sign::kPositive ? "positive" : "non-negative"));
   }
+}
+
+std::vector<double> flag_numbers(const std::string& text, std::size_t count, const char* flag,
+                                 const char* meaning) {
+  std::istringstream in(text);
+  std::vector<double> v;
+  std::string word;
+  while (in >> word) {
+    try {
+      std::size_t used = 0;
+      v.push_back(std::stod(word, &used));
+      if (used != word.size() || !std::isfinite(v.back())) throw std::invalid_argument(word);
+    } catch (const std::exception&) {
+      throw UsageError(std::string(flag) + " \"" + text + "\": '" + word +
+                       "' is not a finite number; give " + meaning);
+    }
+  }
+  if (v.size() != count) {
+    throw UsageError(std::string(flag) + " \"" + text + "\" has " + std::to_string(v.size()) +
+                     " numbers; give " + meaning);
+  }
+  return v;
 }
 
 }  // namespace dynid::cli

@@ -3,6 +3,9 @@
 // Checks of numeric flag values shared by every command: CLI11 parses "nan", "inf" and 1e999 into
 // a double without complaint, and most physical settings are meaningless below zero.
 
+#include <string>
+#include <vector>
+
 #include <CLI/CLI.hpp>
 
 namespace dynid::cli {
@@ -12,5 +15,11 @@ namespace dynid::cli {
 /// (non-negative or positive). A failed check is a usage error naming the flag. Call once, after
 /// all subcommands are registered.
 void check_numeric_flags(CLI::App& app);
+
+/// "a b c ..." (a flag's text, e.g. --sensor-pose "x y z roll pitch yaw") → exactly `count` finite
+/// numbers. Throws UsageError naming the flag, the bad word or the count, and `meaning` (what to
+/// give instead).
+std::vector<double> flag_numbers(const std::string& text, std::size_t count, const char* flag,
+                                 const char* meaning);
 
 }  // namespace dynid::cli
