@@ -23,6 +23,7 @@
 #include "dynid/report/experiment_report.hpp"
 #include "dynid/report/identification_report.hpp"
 #include "dynid/sim/simulate_reference.hpp"
+#include "result_options.hpp"
 
 namespace dynid::cli {
 namespace {
@@ -536,51 +537,13 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
   }
   const std::vector<std::string>& names = identified.names;
   const Eigen::VectorXd& values = identified.values;
-  const nlohmann::json& used = identified.options;
   RunFileReport read;
-  // The same friction set and signal processing as the identification that wrote the file.
-  IdentifyCliOptions o;
-  const FileOptions file_options{used, v.params};
-  o.friction = file_options.get("friction", o.friction);
-  o.no_armature = !file_options.get("armature", true);
-  o.filter = file_options.get("filter", o.filter);
-  // The cut-off identify used (its automatic choice included), not one chosen again on this run.
-  if (cmd.count("--cutoff")) {
-    o.cutoff = v.cutoff;
-  } else if (identified.cutoff_hz > 0.0) {
-    o.cutoff = identified.cutoff_hz;
-    read.notes.push_back("cut-off as identify used it (stored in '" + v.params + "')");
-  } else {
-    o.cutoff = file_options.get("cutoff_hz", 0.0);
-  }
-  o.savgol = file_options.get("savitzky_golay", false);
-  o.torque_offset = file_options.get("torque_offset_s", 0.0);
-  o.filter_coulomb = file_options.get("filter_coulomb_columns", false);
-  // The rows left out are those below the thresholds identify used (stored in the result), not
-  // thresholds recomputed from this run.
-  if (!v.zero_velocity.empty()) {
-    o.zero_velocity = v.zero_velocity;
-  } else if (static_cast<int>(identified.zero_velocity_threshold.size()) == model.dof()) {
-    o.zero_velocity = identified.zero_velocity_threshold;
-    if (*std::max_element(o.zero_velocity.begin(), o.zero_velocity.end()) > 0.0) {
-      read.notes.push_back("zero-velocity thresholds as identify used them (stored in '" +
-                           v.params + "')");
-    }
-  } else {
-    o.zero_velocity = file_options.get("zero_velocity", std::vector<double>{});
-  }
-  if (v.torque_scale.empty() && !cmd.count("--torque-scale")) {
-    file.torque_scale = file_options.get("torque_scale", std::vector<double>{});
-    if (!file.torque_scale.empty()) {
-      read.notes.push_back("--torque-scale as given to identify (stored in '" + v.params + "')");
-    }
-  }
-  IdentifyOptions options;
-  try {
-    options = library_options(o);
-  } catch (const UsageError& e) {
-    throw file_option_error(e, v.params);
-  }
+  ResultOptionOverrides overrides;
+  if (cmd.count("--cutoff")) overrides.cutoff = v.cutoff;
+  overrides.zero_velocity = v.zero_velocity;
+  overrides.torque_scale_given = !v.torque_scale.empty() || cmd.count("--torque-scale");
+  const IdentifyOptions options =
+      options_from_identification_result(identified, v.params, model.dof(), overrides, file, read);
   const JointRecord record = read_joint_record(v.data, model, file, &read);
   if (v.mode == "simulation") {
     RunFileOptions reference_file;
@@ -627,6 +590,54 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
 }
 
 }  // namespace
+
+IdentifyOptions options_from_identification_result(const IdentifiedResultFile& identified,
+                                                   const std::string& path, int dof,
+                                                   const ResultOptionOverrides& overrides,
+                                                   RunFileOptions& file, RunFileReport& read) {
+  // The same friction set and signal processing as the identification that wrote the file.
+  IdentifyCliOptions o;
+  const FileOptions file_options{identified.options, path};
+  o.friction = file_options.get("friction", o.friction);
+  o.no_armature = !file_options.get("armature", true);
+  o.filter = file_options.get("filter", o.filter);
+  // The cut-off identify used (its automatic choice included), not one chosen again on this run.
+  if (overrides.cutoff) {
+    o.cutoff = *overrides.cutoff;
+  } else if (identified.cutoff_hz > 0.0) {
+    o.cutoff = identified.cutoff_hz;
+    read.notes.push_back("cut-off as identify used it (stored in '" + path + "')");
+  } else {
+    o.cutoff = file_options.get("cutoff_hz", 0.0);
+  }
+  o.savgol = file_options.get("savitzky_golay", false);
+  o.torque_offset = file_options.get("torque_offset_s", 0.0);
+  o.filter_coulomb = file_options.get("filter_coulomb_columns", false);
+  // The rows left out are those below the thresholds identify used (stored in the result), not
+  // thresholds recomputed from this run.
+  if (!overrides.zero_velocity.empty()) {
+    o.zero_velocity = overrides.zero_velocity;
+  } else if (static_cast<int>(identified.zero_velocity_threshold.size()) == dof) {
+    o.zero_velocity = identified.zero_velocity_threshold;
+    if (*std::max_element(o.zero_velocity.begin(), o.zero_velocity.end()) > 0.0) {
+      read.notes.push_back("zero-velocity thresholds as identify used them (stored in '" + path +
+                           "')");
+    }
+  } else {
+    o.zero_velocity = file_options.get("zero_velocity", std::vector<double>{});
+  }
+  if (!overrides.torque_scale_given) {
+    file.torque_scale = file_options.get("torque_scale", std::vector<double>{});
+    if (!file.torque_scale.empty()) {
+      read.notes.push_back("--torque-scale as given to identify (stored in '" + path + "')");
+    }
+  }
+  try {
+    return library_options(o);
+  } catch (const UsageError& e) {
+    throw file_option_error(e, path);
+  }
+}
 
 void add_identify_command(CLI::App& app) {
   auto o = std::make_shared<IdentifyCliOptions>();

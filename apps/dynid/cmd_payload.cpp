@@ -23,6 +23,8 @@
 #include "dynid/io/json_writer.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/version.hpp"
+#include "flag_checks.hpp"
+#include "result_options.hpp"
 
 namespace dynid::cli {
 namespace {
@@ -36,29 +38,6 @@ struct PayloadCliOptions {
   double interval = 0.2, wrench_sign = 1.0, confidence = 0.999, cutoff = 0.0;
   bool bias = false, standing = false, no_filter = false;
 };
-
-// "a b c ..." → exactly `count` finite numbers, or a usage error naming the flag.
-std::vector<double> numbers(const std::string& text, std::size_t count, const char* flag,
-                            const char* meaning) {
-  std::istringstream in(text);
-  std::vector<double> v;
-  std::string word;
-  while (in >> word) {
-    try {
-      std::size_t used = 0;
-      v.push_back(std::stod(word, &used));
-      if (used != word.size() || !std::isfinite(v.back())) throw std::invalid_argument(word);
-    } catch (const std::exception&) {
-      throw UsageError(std::string(flag) + " \"" + text + "\": '" + word +
-                       "' is not a finite number; give " + meaning);
-    }
-  }
-  if (v.size() != count) {
-    throw UsageError(std::string(flag) + " \"" + text + "\" has " + std::to_string(v.size()) +
-                     " numbers; give " + meaning);
-  }
-  return v;
-}
 
 // Columns `names` as an m×k block, or empty when none is present; some but not all is an error.
 Eigen::MatrixXd optional_columns(const CsvTable& table, const std::vector<std::string>& names) {
@@ -166,17 +145,69 @@ void write_result(const PayloadCliOptions& cli, const LoadIdentificationResult& 
             << "; wrote " << cli.out << '\n';
 }
 
+// The JSON of a load from joint torques: where it is expressed and which parameters the torques
+// determine.
+void write_torque_result(const PayloadCliOptions& cli, const LoadIdentificationResult& r,
+                         const Model& model, int link,
+                         const std::vector<std::pair<std::string, std::string>>& choices) {
+  std::vector<std::string> joints;
+  for (const auto& joint : model.joints) joints.push_back(joint.name);
+  const nlohmann::json where = {{"robot", model.name},
+                                {"link", model.joints[link].link_name},
+                                {"frame", cli.frame.empty() ? "link frame" : cli.frame}};
+  std::vector<std::string> determined;
+  for (const auto& name : r.names) {
+    if (std::find(r.not_excited.begin(), r.not_excited.end(), name) == r.not_excited.end())
+      determined.push_back(name);
+  }
+  const nlohmann::json extra = {{"reference", cli.reference},
+                                {"determined_by_torques", determined}};
+  write_result(cli, r, "joint_torques", where, extra, choices, joints, true);
+}
+
+// `--link LINK --reference result.json`: the load from the torque that the identified model of
+// the unloaded robot does not explain. The loaded run is processed and predicted exactly as
+// `dynid validate` does with that result (same options, cut-off and zero-velocity thresholds).
+void run_payload_from_result(const PayloadCliOptions& cli, LoadIdentificationOptions options,
+                             const Model& model, int link, const LoadFrame& frame,
+                             RunFileOptions file) {
+  const IdentifiedResultFile identified = read_identification_result(cli.reference);
+  if (!identified.robot.empty() && identified.robot != model.name) {
+    throw Error("--reference '" + cli.reference + "' was identified on robot '" + identified.robot +
+                "' but --robot gives '" + model.name +
+                "'; give a result of the robot that carries the load");
+  }
+  RunFileReport read;
+  const IdentifyOptions identify =
+      options_from_identification_result(identified, cli.reference, model.dof(), {}, file, read);
+  for (const auto& note : read.notes) std::cerr << "payload: " << one_line(note) << '\n';
+  if (cli.cutoff != 0.0 || cli.no_filter) {
+    std::cerr << "warning: --cutoff and --no-filter have no effect with a result.json reference: "
+                 "the loaded run is filtered as identify filtered the unloaded one\n";
+  }
+  const JointRecord loaded_raw = read_joint_record(cli.data, model, file);
+  const ValidationResult predicted =
+      validate_torques(model, loaded_raw, identified.names, identified.values, identify);
+  // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
+  options.hac_covariance = identify.signal.filter;
+  options.record_history = false;
+  const LoadIdentificationResult r = identify_load_from_unexplained_torques(
+      model, link, frame, predicted.processed.record, predicted.predicted,
+      predicted.zero_velocity_threshold, options);
+  std::vector<std::pair<std::string, std::string>> choices = predicted.choices;
+  choices.emplace_back("reference_model",
+                       "the torque of '" + cli.reference +
+                           "' (identify result) predicted on this run as dynid validate does; "
+                           "its own uncertainty is not propagated");
+  write_torque_result(cli, r, model, link, choices);
+}
+
 // `--link LINK --reference unloaded.csv`: robot and load together from joint torques.
 void run_payload_from_torques(const PayloadCliOptions& cli, LoadIdentificationOptions options) {
   if (cli.robot.empty())
     throw UsageError("--link needs --robot R: the robot that carries the load");
   if (cli.reference.empty()) {
     throw UsageError("--link needs --reference: a run of the robot without the load (CSV)");
-  }
-  if (cli.reference.size() >= 5 && cli.reference.substr(cli.reference.size() - 5) == ".json") {
-    throw UsageError("--reference '" + cli.reference +
-                     "': an identify result as reference is not supported yet; give a CSV run "
-                     "of the robot without the load (t, q*, tau*)");
   }
   if (cli.standing || !cli.sensor_link.empty() || !cli.sensor_pose.empty() || cli.bias) {
     throw UsageError(
@@ -186,14 +217,18 @@ void run_payload_from_torques(const PayloadCliOptions& cli, LoadIdentificationOp
   const Model model = load_robot(cli.robot);
   LoadFrame frame;
   if (!cli.frame.empty()) {
-    const auto pose = numbers(cli.frame, 6, "--frame",
-                              "\"x y z roll pitch yaw\" [m, rad] of the frame in the link frame");
+    const auto pose =
+        flag_numbers(cli.frame, 6, "--frame",
+                     "\"x y z roll pitch yaw\" [m, rad] of the frame in the link frame");
     frame.p_LF = Eigen::Vector3d(pose[0], pose[1], pose[2]);
     frame.R_LF = roll_pitch_yaw(pose[3], pose[4], pose[5]);
   }
   const int link = find_link(model, cli.link);
   RunFileOptions file;
   file.columns = parse_column_mapping(cli.columns);
+  const bool json_reference =
+      cli.reference.size() >= 5 && cli.reference.substr(cli.reference.size() - 5) == ".json";
+  if (json_reference) return run_payload_from_result(cli, options, model, link, frame, file);
   const JointRecord loaded_raw = read_joint_record(cli.data, model, file);
   const JointRecord unloaded_raw = read_joint_record(cli.reference, model, file);
   SignalOptions signal;
@@ -207,22 +242,7 @@ void run_payload_from_torques(const PayloadCliOptions& cli, LoadIdentificationOp
   options.record_history = false;
   const LoadIdentificationResult r = identify_load_from_torques(
       model, link, frame, ParameterLayout::full(), loaded, unloaded, options);
-  std::vector<std::string> joints;
-  for (const auto& joint : model.joints) joints.push_back(joint.name);
-  const nlohmann::json where = {{"robot", model.name},
-                                {"link", model.joints[link].link_name},
-                                {"frame", cli.frame.empty() ? "link frame" : cli.frame}};
-  const nlohmann::json extra = {
-      {"reference", cli.reference},
-      {"determined_by_torques", [&] {
-         std::vector<std::string> names;
-         for (const auto& name : r.names) {
-           if (std::find(r.not_excited.begin(), r.not_excited.end(), name) == r.not_excited.end())
-             names.push_back(name);
-         }
-         return names;
-       }()}};
-  write_result(cli, r, "joint_torques", where, extra, choices, joints, true);
+  write_torque_result(cli, r, model, link, choices);
 }
 
 void run_payload(const PayloadCliOptions& cli) {
@@ -261,6 +281,11 @@ void run_payload(const PayloadCliOptions& cli) {
   }
   options.record_history = !cli.history.empty();
   if (!cli.link.empty()) return run_payload_from_torques(cli, options);
+  if (!cli.reference.empty() || !cli.frame.empty()) {
+    throw UsageError(
+        "--reference and --frame are for a load from joint torques: give --link LINK (the link "
+        "that carries the load), or drop them for a wrist-sensor run");
+  }
   if (!cli.robot.empty() && cli.sensor_link.empty()) {
     throw UsageError("--robot needs --sensor-link LINK: the link that carries the sensor");
   }
@@ -302,8 +327,8 @@ void run_payload(const PayloadCliOptions& cli) {
     mount.link = find_link(model, cli.sensor_link);
     if (!cli.sensor_pose.empty()) {
       const auto pose =
-          numbers(cli.sensor_pose, 6, "--sensor-pose",
-                  "\"x y z roll pitch yaw\" [m, rad] of the sensor in the link frame");
+          flag_numbers(cli.sensor_pose, 6, "--sensor-pose",
+                       "\"x y z roll pitch yaw\" [m, rad] of the sensor in the link frame");
       mount.p_LS = Eigen::Vector3d(pose[0], pose[1], pose[2]);
       mount.R_LS = roll_pitch_yaw(pose[3], pose[4], pose[5]);
     }
@@ -344,7 +369,7 @@ void run_payload(const PayloadCliOptions& cli) {
       log.dw = optional_columns(table, {"dwx", "dwy", "dwz"});
       log.a = optional_columns(table, {"ax", "ay", "az"});
     }
-    const auto g = numbers(cli.gravity, 3, "--gravity", "\"gx gy gz\" in m/s^2, base frame");
+    const auto g = flag_numbers(cli.gravity, 3, "--gravity", "\"gx gy gz\" in m/s^2, base frame");
     motion = sensor_motion_from_orientation(log, Eigen::Vector3d(g[0], g[1], g[2]), choices);
     frame = {{"orientation", "qx qy qz qw from the data"}};
   }
@@ -419,7 +444,9 @@ void add_payload_command(CLI::App& app) {
                   "run with the load (t, q*, tau*) and --reference one without it");
   cmd->add_option("--reference", o->reference,
                   "With --link: CSV run of the robot without the load (same or another "
-                  "trajectory); robot and load are identified together");
+                  "trajectory; robot and load are identified together), or the result.json of "
+                  "dynid identify on the unloaded robot (the load from the torque that model "
+                  "does not explain, the run processed as dynid validate does)");
   cmd->add_option("--frame", o->frame,
                   "With --link: \"x y z roll pitch yaw\" of the frame (e.g. the tool flange) in "
                   "the link frame [m, rad] in which the load is reported; default the link frame");
