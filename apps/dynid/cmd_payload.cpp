@@ -198,7 +198,8 @@ void run_payload_from_result(const PayloadCliOptions& cli, LoadIdentificationOpt
   choices.emplace_back("reference_model",
                        "the torque of '" + cli.reference +
                            "' (identify result) predicted on this run as dynid validate does; "
-                           "its own uncertainty is not propagated");
+                           "rows below its zero-velocity thresholds are left out of the load fit "
+                           "too; its own uncertainty is not propagated");
   write_torque_result(cli, r, model, link, choices);
 }
 

@@ -205,7 +205,8 @@ PreparedLoadRun prepare_load_run(const JointRecord& record,
   choices.erase(std::remove_if(choices.begin(), choices.end(),
                                [](const auto& c) { return c.first == "coulomb_columns"; }),
                 choices.end());
-  choices.emplace_back("wrench", "filtered, trimmed and decimated like q");
+  choices.emplace_back("wrench", options.filter ? "filtered, trimmed and decimated like q"
+                                                : "not filtered; trimmed and decimated like q");
   return out;
 }
 
