@@ -171,6 +171,15 @@ int main(int argc, char** argv) {
         }
         e_ma = err_b(ordinary_least_squares(Ww, yw).x);
       }
+      {
+        // The Coulomb work of the filtered velocity, ∫|q̇_j|, instead of parallel filtering.
+        ProcessedRecord serial = p;
+        serial.moving_positive.resize(0, 0);
+        serial.moving_negative.resize(0, 0);
+        const EquationBlock sb = integral_equations(model, def.layout, false, serial, wo);
+        std::printf("  Coulomb columns ∫|dq| (no parallel filtering): %.2f\n",
+                    err_b(ordinary_least_squares(base.select(sb.W), sb.y).x));
+      }
       std::printf("  MA(1) GLS rho1 %.3f: %.2f\n", rho1, e_ma);
       SignalOptions so2 = so;
       so2.cutoff_hz = 2.0;
