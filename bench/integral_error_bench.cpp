@@ -8,11 +8,13 @@
 // treatments for correlated rows and errors in the regressor on the processed equations: AR(1)
 // prewhitening, MA(1) GLS (the shared end points of adjacent intervals), instrumental variables.
 // Not a benchmark: its table is in docs/methods/estimation.md ("Integral model").
-// Run: ./build/bench/integral_error_bench [position-noise-scale [torque-noise-scale]].
+// Run: ./build/bench/integral_error_bench [position-noise-scale [torque-noise-scale [after]]]
+// (after = 1: encoder noise added to the log of a run with exact feedback, no jitter).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <random>
 #include <vector>
 
 #include <Eigen/SVD>
@@ -28,15 +30,24 @@ namespace {
 using namespace dynid;
 
 double g_noise = 1.0, g_torque_noise = 1.0;
+// 1: the encoder noise is added to the log after a run with exact position feedback, so the true
+// motion carries no jitter from the controller's reaction to the noise.
+bool g_after = false;
 
 ClosedLoopResult run(const Model& model, unsigned seed, double ts) {
   SensorOptions so;
-  so.position_noise_std = 1e-4 * g_noise;
+  so.position_noise_std = g_after ? 0.0 : 1e-4 * g_noise;
   so.torque_noise_std = 0.05 * g_torque_noise;
   so.seed = seed;
-  return integral_testing::simulate(model,
-                                    integral_testing::multisine(model.dof(), 10.0, ts, seed, 1.0),
-                                    ts, so, PlantOptions{}, 2);
+  ClosedLoopResult r = integral_testing::simulate(
+      model, integral_testing::multisine(model.dof(), 10.0, ts, seed, 1.0), ts, so, PlantOptions{},
+      2);
+  if (g_after) {
+    std::mt19937 rng(seed + 100);
+    std::normal_distribution<double> normal(0.0, 1e-4 * g_noise);
+    for (Eigen::Index k = 0; k < r.q.size(); ++k) r.q.data()[k] += normal(rng);
+  }
+  return r;
 }
 
 // Rows [first, first + m) of the true run as a processed record.
@@ -56,6 +67,7 @@ ProcessedRecord truth_rows(const ClosedLoopResult& r, Eigen::Index first, Eigen:
 int main(int argc, char** argv) {
   if (argc > 1) g_noise = std::atof(argv[1]);
   if (argc > 2) g_torque_noise = std::atof(argv[2]);
+  if (argc > 3) g_after = std::atoi(argv[3]) != 0;
   Model model = load_robot("puma560");
   for (int j = 0; j < model.dof(); ++j) {
     model.joints[j].friction = {0.05 * (j + 1), 0.5 + 0.1 * j, 0.3 + 0.1 * j, 0.1 * (j + 1)};
