@@ -199,6 +199,20 @@ int main(int argc, char** argv) {
       const ProcessedRecord p2 = preprocess(a, so2, choices);
       const EquationBlock z = integral_equations(model, def.layout, false, p2, io);
       const Eigen::MatrixXd Z = base.select(weight.asDiagonal() * z.W);
+      {
+        // Link energy columns from the same run filtered at half the cut-off (less endpoint
+        // velocity noise), power and per-joint columns at the cut-off.
+        SignalOptions half = so;
+        half.cutoff_hz = 0.5 * so.cutoff_hz;
+        half.trim = p.trim;
+        const EquationBlock hb =
+            integral_equations(model, def.layout, false, preprocess(a, half, choices), io);
+        Eigen::MatrixXd W = f.W;
+        W.leftCols(friction_begin) = hb.W.leftCols(friction_begin);
+        W = weight.asDiagonal() * W;
+        std::printf("  energy columns at half the cut-off: %.2f\n",
+                    err_b(ordinary_least_squares(base.select(W), weight.cwiseProduct(f.y)).x));
+      }
       const Eigen::VectorXd x_iv = (Z.transpose() * Wf).fullPivLu().solve(Z.transpose() * yf);
       std::printf("  treatments: OLS %.2f, AR(1) rho %.3f: %.2f / %.2f (3 passes), IV(2 Hz) %.2f\n",
                   e_ols, rho, e_ar[0], e_ar[2], err_b(x_iv));
