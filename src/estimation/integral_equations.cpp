@@ -166,6 +166,30 @@ EquationBlock integral_equations(const Model& model, const ParameterLayout& layo
   if (options.rule != IntegrationRule::kZeroOrderHold) {
     power = (r.tau.array() * r.dq.array()).rowwise().sum();
   }
+  // Parallel filtering of the Coulomb work (the one discontinuous term): the filtered torque's
+  // Coulomb part is Fc_j·filter(sign q̇_j), so its power is q̇_j·(p_j − n_j) with the record's
+  // filtered moving-positive/-negative indicators, integrated like τᵀq̇; ∫|q̇_j| of the filtered
+  // velocity would miss the smeared step at every reversal.
+  const bool parallel_coulomb = layout.coulomb && processed.moving_positive.rows() == m &&
+                                processed.moving_negative.rows() == m;
+  const int coulomb_within =
+      (layout.armature ? 1 : 0) + (layout.viscous ? (layout.asymmetric ? 2 : 1) : 0);
+  Eigen::MatrixXd coulomb_positive, coulomb_negative;  // m × n powers q̇_j·p_j, q̇_j·n_j
+  if (parallel_coulomb) {
+    coulomb_positive = r.dq.cwiseProduct(processed.moving_positive);
+    coulomb_negative = r.dq.cwiseProduct(processed.moving_negative);
+  }
+  auto coulomb_work = [&](bool positive, Eigen::Index a, Eigen::Index e, int j) {
+    const Eigen::MatrixXd& moving =
+        positive ? processed.moving_positive : processed.moving_negative;
+    if (options.rule == IntegrationRule::kZeroOrderHold) {
+      double w = 0.0;
+      for (Eigen::Index k = a; k < e; ++k) w += moving(k, j) * (r.q(k + 1, j) - r.q(k, j));
+      return w;
+    }
+    return integrate_samples(r.t, (positive ? coulomb_positive : coulomb_negative).col(j), a, e,
+                             options.rule);
+  };
   Eigen::VectorXd square(n);  // per-joint ∫q̇_j² of one step, reused by the coupled motors
   energy_row(0, h_prev);
   for (Eigen::Index i = 0; i < intervals; ++i) {
@@ -196,6 +220,19 @@ EquationBlock integral_equations(const Model& model, const ParameterLayout& layo
         w[col + 1] += u.positive_square + u.negative_square -
                       (nk.array().square().transpose() * square.array()).sum();
         w[col + 2] += u.positive - u.negative;
+      }
+    }
+    if (parallel_coulomb) {
+      for (int j = 0; j < n; ++j) {
+        const Eigen::Index col = kLinkParams * n + jc * j + coulomb_within;
+        const double pos = coulomb_work(true, a, e, j);
+        const double neg = coulomb_work(false, a, e, j);
+        if (layout.asymmetric) {
+          w[col] = pos;
+          w[col + 1] = -neg;
+        } else {
+          w[col] = pos - neg;
+        }
       }
     }
     b.sample[i] = static_cast<int>(i);

@@ -117,7 +117,7 @@ TEST(IntegralIrp6, TruthInsideIntervalsShortIntegralsAndDifferential) {
 // small against the endpoint velocity noise, which enters every short row twice (e_{i+1} − e_i)
 // but a long row only through its two ends while its energy change grows; the friction and
 // torque-noise errors that long integrals accumulate stay small here (no torque bias, white
-// noise). The test pins the measured order (short 18 %, long 2.2 %, differential 0.5 % torque
+// noise). The test pins the measured order (short 6.3 %, long 0.70 %, differential 0.54 % torque
 // prediction error on the run); docs/methods/estimation.md §7 has the puma560 and TX40 figures.
 TEST(IntegralIrp6, LongIntegralsBeatShortOnesHereUnlikeSeed1) {
   const Irp6Results& r = results();

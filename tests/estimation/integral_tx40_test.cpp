@@ -74,12 +74,13 @@ double value(const Tx40Integral& r, const std::string& name) {
 }
 
 // What the integral model gets on this run with its defaults (issue 11 item 7; numbers in
-// docs/methods/estimation.md, "Integral model"): the friction is within 10 % of the published
-// values only for Fv1 (Fv2, Fv5 and Fvm6 within 13 %); Fc3, Fc4 and Fc6 come out with the wrong
-// sign, and the torque prediction is ~8× worse than the differential model's. One scalar
+// docs/methods/estimation.md, "Integral model"): of the 12 joint friction values, Fv1, Fv2 and Fv5
+// are within 10 % of the published ones (and Fvm6); the Coulomb values are not (Fc4 with the
+// wrong sign), and the torque prediction is ~7× worse than the differential model's. One scalar
 // equation per interval sums the power of all six joints, so the small joints' friction is
-// weakly determined. The test pins these numbers so that a change to the builder or the
-// defaults that moves them is seen.
+// weakly determined. Parallel filtering of the Coulomb work raised the count from 1 to 3 and cut
+// the torque error from 41 % to 35 %. The test pins these numbers so that a change to the builder
+// or the defaults that moves them is seen.
 TEST(IntegralTx40, FrictionAgainstPublishedValues) {
   const Tx40Integral* r = data();
   if (r == nullptr) GTEST_SKIP() << "data set not found at " << kData;
@@ -96,9 +97,12 @@ TEST(IntegralTx40, FrictionAgainstPublishedValues) {
   const double fvm = r->published["fvm6"].as<double>(), fsm = r->published["fsm6"].as<double>();
   std::cout << "Fvm6 " << value(*r, "Fvm6") << " (published " << fvm << "), Fcm6 "
             << value(*r, "Fcm6") << " (published " << fsm << ")\n";
-  EXPECT_NEAR(value(*r, "Fv1"), r->published["fv"][0].as<double>(),
-              0.1 * r->published["fv"][0].as<double>());
-  EXPECT_EQ(within, 1) << "of the 12 joint friction values within 10 %";
+  for (int j : {0, 1, 4}) {
+    const double fv = r->published["fv"][j].as<double>();
+    EXPECT_NEAR(value(*r, "Fv" + std::to_string(j + 1)), fv, 0.1 * fv);
+  }
+  EXPECT_NEAR(value(*r, "Fvm6"), fvm, 0.1 * fvm);
+  EXPECT_EQ(within, 3) << "of the 12 joint friction values within 10 %";
   std::cout << "energy equations: relative error " << r->estimate.relative_error << "\n";
   EXPECT_LT(r->estimate.relative_error, 0.05);
 }

@@ -23,7 +23,10 @@ inline constexpr int kAutoIntervalSteps = 2;
 /// (Iam), ∫ (u² − Σ_j n_kj²q̇_j²) (Fvm), ∫ |u| (Fcm). Columns are stacked_regressor_names(model,
 /// layout, coupling), so base parameters and names are those of the differential model. The
 /// power uses options.rule; the friction integrals use step_velocity_integrals on every step
-/// (exact when q is a cubic over the step). No acceleration is used.
+/// (exact when q is a cubic over the step), except that when `processed` carries the filtered
+/// moving indicators p_j, n_j (ProcessedRecord::moving_positive/negative) the Coulomb columns are
+/// ∫ q̇_j·(p_j − n_j) (asymmetric ∫ q̇_j·p_j, −∫ q̇_j·n_j) by options.rule: the Coulomb part of
+/// the filtered power (parallel filtering). No acceleration is used.
 /// Units: y [J], columns [J per parameter unit] (times the row weight of options.weighting).
 /// Block: ⌊(m − 1)/steps⌋ rows (m samples, `steps` per interval) × the named columns; group 0 =
 /// "energy" for every row, sample = interval index, t = interval end [s]. Throws
