@@ -303,6 +303,18 @@ struct FileOptions {
   }
 };
 
+// A result whose data left base parameters undetermined holds data regroupings, not a model:
+// used as a whole model it would simulate or compensate with wrong numbers.
+void refuse_undetermined(const IdentifiedResultFile& f, const std::string& path,
+                         const std::string& use) {
+  if (f.not_excited.empty()) return;
+  std::string list;
+  for (const std::string& name : f.not_excited) list += (list.empty() ? "" : ", ") + name;
+  throw Error("'" + path + "' does not determine " + list +
+              " (not_excited), so it is no complete model to " + use +
+              "; identify from runs that also excite them");
+}
+
 // The model whose rigid-body and armature torques a friction experiment subtracts: the robot's
 // nominal one, or the one identified in `params` (its base parameters, the rest nominal).
 Model compensation_model(const Model& model, const std::string& params) {
@@ -312,6 +324,7 @@ Model compensation_model(const Model& model, const std::string& params) {
     throw Error("'" + params + "' was identified on robot '" + f.robot + "' but --robot gives '" +
                 model.name + "'; give a result of this robot");
   }
+  refuse_undetermined(f, params, "compensate a friction experiment with it");
   IdentifyCliOptions o;
   const FileOptions file_options{f.options, params};
   o.friction = file_options.get("friction", o.friction);
@@ -551,6 +564,7 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
     const JointRecord ref = read_reference(v.trajectory, model, reference_file);
     PlantOptions plant;
     plant.engine = v.engine == "mujoco" ? PlantEngine::kMujoco : PlantEngine::kNative;
+    refuse_undetermined(identified, v.params, "simulate");
     echo_choices("validate", read, {});
     const SimulationValidation sv =
         validate_run_by_simulation(identified_model(model, names, values, options), ref.t, ref.q,
@@ -564,7 +578,7 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
   }
   ValidationResult result;
   try {
-    result = validate_torques(model, record, names, values, options);
+    result = validate_torques(model, record, names, values, options, identified.not_excited);
   } catch (const UsageError& e) {  // --zero-velocity is the user's own when given
     if (!v.zero_velocity.empty()) throw;
     throw file_option_error(e, v.params);

@@ -186,8 +186,8 @@ void run_payload_from_result(const PayloadCliOptions& cli, LoadIdentificationOpt
                  "the loaded run is filtered as identify filtered the unloaded one\n";
   }
   const JointRecord loaded_raw = read_joint_record(cli.data, model, file);
-  const ValidationResult predicted =
-      validate_torques(model, loaded_raw, identified.names, identified.values, identify);
+  const ValidationResult predicted = validate_torques(
+      model, loaded_raw, identified.names, identified.values, identify, identified.not_excited);
   // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
   options.hac_covariance = identify.signal.filter;
   options.record_history = false;

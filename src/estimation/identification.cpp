@@ -1,5 +1,6 @@
 #include "dynid/estimation/identification.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -596,10 +597,13 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
 
 ValidationResult validate_torques(const Model& model, const JointRecord& record,
                                   const std::vector<std::string>& names,
-                                  const Eigen::VectorXd& values, const IdentifyOptions& options) {
+                                  const Eigen::VectorXd& values, const IdentifyOptions& options,
+                                  const std::vector<std::string>& not_excited) {
   const int n = model.dof();
   ValidationResult out;
   out.processed = preprocess_run(model, record, options.signal, out.choices);
+  // As identify() does: a joint held by its controller did not move (its jitter is noise).
+  hold_still_joints(model, out.processed, out.choices);
   const JointRecord& r = out.processed.record;
   // The same equations as identify(): every row for the headline figures, and the rows its
   // zero-velocity rule keeps (near-still rows of a Coulomb model: their sign(dq) is noise).
@@ -609,20 +613,25 @@ ValidationResult validate_torques(const Model& model, const JointRecord& record,
   const std::vector<std::string>& columns = all.columns;
   // Each identified parameter selects its leading standard column: W_b·theta_b uses the base
   // columns only (W_2 = W_1·K_d is folded into theta_b).
-  Eigen::VectorXd theta = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(columns.size()));
-  for (size_t i = 0; i < names.size(); ++i) {
-    std::string lead = names[i];
+  const auto column_of = [&columns](const std::string& name) {
+    std::string lead = name;
     auto it = std::find(columns.begin(), columns.end(), lead);
     if (it == columns.end() && !lead.empty() && lead.back() == 'R') {
       lead.pop_back();
       it = std::find(columns.begin(), columns.end(), lead);
     }
     if (it == columns.end()) {
-      throw Error("parameter '" + names[i] +
+      throw Error("parameter '" + name +
                   "' of the result is not a column of this model and friction set; identify and "
                   "validate with the same robot and --friction options");
     }
-    theta[it - columns.begin()] = values[static_cast<Eigen::Index>(i)];
+    return static_cast<int>(it - columns.begin());
+  };
+  Eigen::VectorXd theta = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(columns.size()));
+  std::vector<int> determined;
+  for (size_t i = 0; i < names.size(); ++i) {
+    determined.push_back(column_of(names[i]));
+    theta[determined.back()] = values[static_cast<Eigen::Index>(i)];
   }
   const Eigen::VectorXd pred = all.W * theta;
   const Eigen::Index m = r.t.size();
@@ -635,6 +644,21 @@ ValidationResult validate_torques(const Model& model, const JointRecord& record,
   out.zero_velocity_threshold = threshold;
   const Eigen::MatrixXd e = r.tau - out.predicted;
   const EquationBlock moving = moving_rows(all, r.dq, threshold);
+  if (!not_excited.empty() && moving.y.size() > 0) {
+    std::vector<int> together = determined;
+    for (const std::string& name : not_excited) together.push_back(column_of(name));
+    std::sort(determined.begin(), determined.end());
+    std::sort(together.begin(), together.end());
+    if (data_identifiability(select_columns(moving, together)).rank >
+        data_identifiability(select_columns(moving, determined)).rank) {
+      std::string list;
+      for (const std::string& name : not_excited) list += (list.empty() ? "" : ", ") + name;
+      throw Error("the result does not determine " + list +
+                  " (not_excited: its identification data did not move them) but this run "
+                  "excites them, so its torques cannot be predicted; validate on a run like the "
+                  "identification run(s), or identify from runs that also excite those");
+    }
+  }
   const Eigen::VectorXd e_moving = moving.y - moving.W * theta;
   Eigen::VectorXd e2 = Eigen::VectorXd::Zero(n), y2 = Eigen::VectorXd::Zero(n),
                   cnt = Eigen::VectorXd::Zero(n);

@@ -225,6 +225,22 @@ IdentifiedResultFile read_identification_result(const std::string& path) {
       out.zero_velocity_threshold.push_back(x.get<double>());
     }
   }
+  const auto not_excited = j.find("not_excited");
+  if (not_excited != j.end()) {
+    if (!not_excited->is_array()) {
+      throw Error("'" + path +
+                  "': not_excited must be a list of parameter names (as dynid "
+                  "identify writes it)");
+    }
+    for (const auto& name : *not_excited) {
+      if (!name.is_string()) {
+        throw Error("'" + path +
+                    "': not_excited must be a list of parameter names (as dynid "
+                    "identify writes it)");
+      }
+      out.not_excited.push_back(name.get<std::string>());
+    }
+  }
   const auto choices = j.find("choices");
   if (choices != j.end() && choices->is_object() && choices->contains("cutoff_hz")) {
     const auto& c = (*choices)["cutoff_hz"];

@@ -241,9 +241,16 @@ struct ValidationResult {
 /// .zero_velocity (give the identification's IdentificationResult::zero_velocity_threshold), else
 /// the automatic rule of identify() on this record. A name that is not a column of the model
 /// and layout is an Error naming the parameter.
+/// `not_excited` are the base parameters the identification data did not determine
+/// (IdentificationResult::not_excited): the estimates then hold data regroupings that predict only
+/// motions which leave those directions unexcited too. When this record excites a direction the
+/// result does not determine (the data rank of its determined and undetermined columns together
+/// exceeds that of the determined ones), the prediction would be a wrong number: Error naming the
+/// parameters.
 ValidationResult validate_torques(const Model& model, const JointRecord& record,
                                   const std::vector<std::string>& names,
-                                  const Eigen::VectorXd& values, const IdentifyOptions& options);
+                                  const Eigen::VectorXd& values, const IdentifyOptions& options,
+                                  const std::vector<std::string>& not_excited = {});
 
 /// A Model whose dynamics are those of identified base parameters: the dependent standard
 /// parameters theta_2 keep the nominal model's values and theta_1 = theta_b − K_d·theta_2

@@ -36,6 +36,9 @@ struct IdentifiedResultFile {
   /// `choices.cutoff_hz`, the low-pass cut-off identify used [Hz]; 0 when absent (no filter, or
   /// a file written before it was stored).
   double cutoff_hz = 0.0;
+  /// `not_excited`: base parameters the identification data did not determine (empty in files
+  /// written before it was stored).
+  std::vector<std::string> not_excited;
 };
 
 /// Reads a result JSON (identification_to_json). Throws dynid::Error naming the file when
