@@ -20,8 +20,10 @@
 #include "dynid/io/json_writer.hpp"
 #include "dynid/io/streaming_identification.hpp"
 #include "dynid/model/robots.hpp"
+#include "dynid/report/control_report.hpp"
 #include "dynid/report/experiment_report.hpp"
 #include "dynid/report/identification_report.hpp"
+#include "dynid/sim/pid_gains.hpp"
 #include "dynid/sim/simulate_reference.hpp"
 #include "result_options.hpp"
 
@@ -510,6 +512,7 @@ Error file_option_error(const UsageError& e, const std::string& path) {
 struct ValidateCliOptions {
   std::string robot, params, data, json, columns, mode = "torque", trajectory, engine = "mujoco";
   std::string predicted;
+  std::string controller, gains, histograms;  // --mode simulation: the run's loop, error PDFs
   double rate = 0.0;
   std::vector<double> zero_velocity;
   std::vector<double> torque_scale;
@@ -536,10 +539,15 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
   if (v.mode == "simulation") {
     require_readable(v.trajectory, "--trajectory");
     if (!v.predicted.empty()) warn("--predicted has no effect with --mode simulation");
+    if (!v.gains.empty()) require_readable(v.gains, "--gains");
+    require_output_folder(v.histograms, "--histograms");
     if (cmd.count("--zero-velocity")) warn("--zero-velocity has no effect with --mode simulation");
   } else {
     if (!v.trajectory.empty()) warn("--trajectory has no effect with --mode torque");
     if (cmd.count("--engine")) warn("--engine has no effect with --mode torque");
+    if (!v.controller.empty() || !v.gains.empty() || !v.histograms.empty()) {
+      warn("--controller, --gains and --histograms have no effect with --mode torque");
+    }
   }
   const Model model = load_robot(v.robot);
   const IdentifiedResultFile identified = read_identification_result(v.params);
@@ -565,11 +573,36 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
     PlantOptions plant;
     plant.engine = v.engine == "mujoco" ? PlantEngine::kMujoco : PlantEngine::kNative;
     refuse_undetermined(identified, v.params, "simulate");
+    // The run's own loop: --gains, else the gains file simulate wrote beside the run.
+    PidGains gains;
+    const std::string beside = gains_file_for_run(v.data);
+    if (!v.gains.empty()) {
+      gains = read_pid_gains(v.gains, model);
+    } else if (std::ifstream(beside)) {
+      gains = read_pid_gains(beside, model);
+      read.notes.push_back("controller gains from '" + beside + "'");
+    }
+    const std::string controller =
+        !v.controller.empty() ? v.controller
+                              : (!gains.controller.empty() ? gains.controller : "pid-feedforward");
+    if (controller != "pid" && controller != "pid-feedforward" && controller != "computed-torque") {
+      throw UsageError("--controller must be pid, pid-feedforward or computed-torque, not '" +
+                       controller + "'");
+    }
+    const FeedForward feed_forward = controller == "pid" ? FeedForward::kNone
+                                     : controller == "computed-torque"
+                                         ? FeedForward::kInverseDynamics
+                                         : FeedForward::kComputedTorque;
+    read.notes.push_back("controller " + controller);
     echo_choices("validate", read, {});
-    const SimulationValidation sv =
-        validate_run_by_simulation(identified_model(model, names, values, options), ref.t, ref.q,
-                                   ref.dq, ref.ddq, record.q, record.tau, plant);
+    const SimulationValidation sv = validate_run_by_simulation(
+        identified_model(model, names, values, options), ref.t, ref.q, ref.dq, ref.ddq, record.q,
+        record.tau, plant, feed_forward, gains);
     std::cout << simulation_validation_table(model, sv);
+    if (!v.histograms.empty()) {
+      write_error_histograms(v.histograms, model, sv);
+      std::cout << "wrote " << v.histograms << '\n';
+    }
     if (!v.json.empty()) {
       write_json(v.json, simulation_validation_to_json(model, sv));
       std::cout << "wrote " << v.json << '\n';
@@ -653,6 +686,10 @@ IdentifyOptions options_from_identification_result(const IdentifiedResultFile& i
   }
 }
 
+Model model_from_result(const Model& model, const std::string& params) {
+  return compensation_model(model, params);
+}
+
 void add_identify_command(CLI::App& app) {
   auto o = std::make_shared<IdentifyCliOptions>();
   CLI::App* cmd = app.add_subcommand(
@@ -727,6 +764,17 @@ void add_validate_command(CLI::App& app) {
                   "With --mode simulation: the reference CSV of the run");
   cmd->add_option("--engine", v->engine, "With --mode simulation: mujoco or native")
       ->capture_default_str();
+  cmd->add_option("--controller", v->controller,
+                  "With --mode simulation: the loop the run was made with, pid, pid-feedforward or "
+                  "computed-torque (with the identified model); default: the controller named in "
+                  "the gains file, else pid-feedforward");
+  cmd->add_option("--gains", v->gains,
+                  "With --mode simulation: YAML/JSON with kp, ki, kd lists; default: "
+                  "<data>.gains.json beside the run when present (simulate writes it), else the "
+                  "bandwidth rule");
+  cmd->add_option("--histograms", v->histograms,
+                  "With --mode simulation: write the position and torque error PDFs as CSV, per "
+                  "joint bin centre, density and the Gaussian of the same mean and std");
   cmd->add_option("--predicted", v->predicted,
                   "Write t and, per joint, measured torque, predicted torque, residual and a "
                   "left-out flag as CSV (tau<j>, tau_pred<j>, residual<j>, left_out<j>)");

@@ -19,6 +19,7 @@ namespace {
 
 struct SimulateCliOptions {
   std::string robot, trajectory, out, engine = "mujoco", controller = "pid-feedforward", gains;
+  std::string params;  // --params: identified model of computed-torque
   int periods = 25, delay = 0;
   unsigned seed = 1;
   double position_noise = 0.0, torque_noise = 0.0, counts_per_rev = 0.0;
@@ -27,14 +28,6 @@ struct SimulateCliOptions {
   std::string payload, payload_link, sensor_pose;
   std::vector<double> wrench_noise;
 };
-
-// The gains file written next to the run: run.csv -> run.gains.json (docs/cli.md).
-std::string gains_file_for(const std::string& out) {
-  const std::string suffix = ".csv";
-  const bool csv = out.size() > suffix.size() &&
-                   out.compare(out.size() - suffix.size(), suffix.size(), suffix) == 0;
-  return (csv ? out.substr(0, out.size() - suffix.size()) : out) + ".gains.json";
-}
 
 // The load of --payload on --payload-link at --sensor-pose, or none; usage errors name the flag.
 std::optional<MountedLoad> payload_options(const SimulateCliOptions& o, const Model& model) {
@@ -67,15 +60,26 @@ void run(const SimulateCliOptions& o) {
   if (o.engine != "mujoco" && o.engine != "native") {
     throw UsageError("--engine must be mujoco or native, not '" + o.engine + "'");
   }
-  if (o.controller != "pid" && o.controller != "pid-feedforward") {
-    throw UsageError("--controller must be pid or pid-feedforward, not '" + o.controller + "'");
+  if (o.controller != "pid" && o.controller != "pid-feedforward" &&
+      o.controller != "computed-torque") {
+    throw UsageError("--controller must be pid, pid-feedforward or computed-torque, not '" +
+                     o.controller + "'");
+  }
+  if ((o.controller == "computed-torque") != !o.params.empty()) {
+    throw UsageError(o.params.empty() ? "--controller computed-torque needs --params result.json "
+                                        "(the identified model it is computed from)"
+                                      : "--params is for --controller computed-torque; drop it "
+                                        "or add --controller computed-torque");
   }
   if (o.periods < 1) throw UsageError("--periods must be >= 1");
   const Model model = load_robot(o.robot);
   const std::optional<MountedLoad> load = payload_options(o, model);
   const JointRecord ref = read_reference(o.trajectory, model);
   SimulateOptions s;
-  s.feed_forward = o.controller == "pid" ? FeedForward::kNone : FeedForward::kComputedTorque;
+  s.feed_forward = o.controller == "pid"               ? FeedForward::kNone
+                   : o.controller == "computed-torque" ? FeedForward::kInverseDynamics
+                                                       : FeedForward::kComputedTorque;
+  if (!o.params.empty()) s.controller_model = model_from_result(model, o.params);
   if (!o.gains.empty()) s.gains = read_pid_gains(o.gains, model);
   s.plant.engine = o.engine == "mujoco" ? PlantEngine::kMujoco : PlantEngine::kNative;
   s.sensors.position_noise_std = o.position_noise;
@@ -107,7 +111,7 @@ void run(const SimulateCliOptions& o) {
                      o.wrench_noise.empty() ? 0.0 : o.wrench_noise.back(), o.seed + 1);
     data.rightCols(6) = wrench;
   }
-  const std::string gains_path = gains_file_for(o.out);
+  const std::string gains_path = gains_file_for_run(o.out);
   write_csv(o.out, cols, data);
   write_pid_gains(gains_path, model, pid, o.delay);
   std::cout << "simulated " << r.t.size() << " samples (" << o.periods << " periods) on the "
@@ -134,8 +138,12 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--controller", o->controller,
                   "pid (plain joint PID, the closed loop of B. Bona, A. Curatella, Closed-loop "
                   "rigid model identification of an industrial robot, 2005) or pid-feedforward "
-                  "(PID plus computed torque from the true model)")
+                  "(PID plus computed torque from the true model) or computed-torque (the "
+                  "computed-torque law with the model identified in --params: mass matrix, "
+                  "Coriolis, gravity and friction, the PID correcting the acceleration)")
       ->capture_default_str();
+  cmd->add_option("--params,-p", o->params,
+                  "With --controller computed-torque: result.json of dynid identify");
   cmd->add_option("--gains", o->gains,
                   "YAML file with kp, ki, kd lists (one value per joint); default: a bandwidth "
                   "rule that accounts for --delay. The gains used are written to <out>.gains.json");

@@ -12,6 +12,7 @@ void add_commands(CLI::App& app) {
   add_validate_command(app);
   add_excite_command(app);
   add_simulate_command(app);
+  add_compare_control_command(app);
   add_average_command(app);
   add_demo_command(app);
   add_payload_command(app);

@@ -3,7 +3,11 @@
 // The dynid subcommands. Each file cmd_<name>.cpp registers one subcommand: parse -> validate ->
 // call the library -> write results. No math here (DESIGN.md section 2).
 
+#include <string>
+
 #include <CLI/CLI.hpp>
+
+#include "dynid/model/model.hpp"
 
 namespace dynid::cli {
 
@@ -38,5 +42,13 @@ void add_average_command(CLI::App& app);
 
 /// `dynid payload`: a gripped load's parameters from a wrist force/torque sensor (cmd_payload.cpp).
 void add_payload_command(CLI::App& app);
+
+/// `dynid compare-control`: PID vs computed-torque tracking on one plant (cmd_compare_control.cpp).
+void add_compare_control_command(CLI::App& app);
+
+/// The model of identified base parameters in result JSON `params` (identified_model(), with the
+/// friction set and armature the file records), or `model` itself when params is empty. Throws
+/// dynid::Error naming the file (unreadable, another robot, a name that is no base parameter).
+Model model_from_result(const Model& model, const std::string& params);
 
 }  // namespace dynid::cli

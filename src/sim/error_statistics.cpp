@@ -74,4 +74,33 @@ ErrorStatistics error_statistics(const Eigen::Ref<const Eigen::VectorXd>& e) {
   return s;
 }
 
+ErrorHistogram error_histogram(const Eigen::Ref<const Eigen::VectorXd>& e, int bins) {
+  if (bins < 1) throw Error("a histogram needs at least 1 bin, got " + std::to_string(bins));
+  const ErrorStatistics stats = error_statistics(e);  // checks size and finiteness
+  double lo = e.minCoeff(), hi = e.maxCoeff();
+  if (hi - lo <= 0.0) {
+    lo -= 0.5;
+    hi += 0.5;
+  }
+  const double width = (hi - lo) / bins;
+  ErrorHistogram h;
+  h.center.resize(bins);
+  h.density = Eigen::VectorXd::Zero(bins);
+  h.gaussian = Eigen::VectorXd::Zero(bins);
+  for (Eigen::Index k = 0; k < e.size(); ++k) {
+    const int b = std::clamp(static_cast<int>((e[k] - lo) / width), 0, bins - 1);
+    h.density[b] += 1.0;
+  }
+  h.density /= static_cast<double>(e.size()) * width;
+  constexpr double kPi = 3.14159265358979323846;
+  for (int b = 0; b < bins; ++b) {
+    h.center[b] = lo + (b + 0.5) * width;
+    if (stats.std > 0.0) {
+      const double z = (h.center[b] - stats.mean) / stats.std;
+      h.gaussian[b] = std::exp(-0.5 * z * z) / (stats.std * std::sqrt(2.0 * kPi));
+    }
+  }
+  return h;
+}
+
 }  // namespace dynid

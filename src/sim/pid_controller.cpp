@@ -5,6 +5,7 @@
 #include <string>
 
 #include "dynid/common/error.hpp"
+#include "dynid/dynamics/mass_matrix.hpp"
 #include "dynid/dynamics/rnea.hpp"
 
 namespace dynid {
@@ -59,6 +60,23 @@ PidController::PidController(const Model& model, const PidOptions& options)
   y_prev_ = Eigen::VectorXd::Zero(n);
   velocity_ = Eigen::VectorXd::Zero(n);
   feed_forward_ = Eigen::VectorXd::Zero(n);
+  if (options_.feed_forward == FeedForward::kInverseDynamics) {
+    if (options.inertia.size() != 0) {
+      if (options.inertia.size() != n)
+        throw Error("PID inertia has " + std::to_string(options.inertia.size()) +
+                    " entries but the model has " + std::to_string(n) +
+                    " joints: give one per joint or none (diag M at the first measurement)");
+      for (int j = 0; j < n; ++j)
+        if (!(options.inertia[j] > 0.0) || !std::isfinite(options.inertia[j]))
+          throw Error("PID inertia of joint '" + model_.joints[j].name +
+                      "' must be finite and > 0 [kg·m²]");
+      inertia_ = options.inertia;
+    }
+    integral_next_ = Eigen::VectorXd::Zero(n);
+    pid_ = Eigen::VectorXd::Zero(n);
+    acceleration_ = Eigen::VectorXd::Zero(n);
+    mass_ = Eigen::MatrixXd::Zero(n, n);
+  }
 }
 
 void PidController::reset(const Eigen::Ref<const Eigen::VectorXd>& y0) {
@@ -68,6 +86,16 @@ void PidController::reset(const Eigen::Ref<const Eigen::VectorXd>& y0) {
   integral_.setZero();
   velocity_.setZero();
   y_prev_ = y0;
+  if (options_.feed_forward == FeedForward::kInverseDynamics && options_.inertia.size() == 0) {
+    mass_matrix(model_, ws_, y0, mass_);
+    inertia_ = mass_.diagonal();
+    for (int j = 0; j < model_.dof(); ++j)
+      if (!(inertia_[j] > 0.0) || !std::isfinite(inertia_[j]))
+        throw Error("computed-torque control: the model's inertia about joint '" +
+                    model_.joints[j].name + "' is " + std::to_string(inertia_[j]) +
+                    " at the first position; the model (e.g. identified parameters) must give "
+                    "every joint a positive inertia");
+  }
 }
 
 void PidController::update(const Eigen::Ref<const Eigen::VectorXd>& qr,
@@ -76,24 +104,58 @@ void PidController::update(const Eigen::Ref<const Eigen::VectorXd>& qr,
                            const Eigen::Ref<const Eigen::VectorXd>& y,
                            Eigen::Ref<Eigen::VectorXd> tau) {
   const int n = model_.dof();
-  const double ts = options_.sample_time, tf = options_.derivative_filter_time;
+  if (options_.feed_forward == FeedForward::kInverseDynamics) {
+    update_inverse_dynamics(qr, dqr, ddqr, y, tau);
+    return;
+  }
   if (options_.feed_forward == FeedForward::kComputedTorque)
     rnea(model_, ws_, qr, dqr, ddqr, feed_forward_);
   for (int j = 0; j < n; ++j) {
     const double e = qr[j] - y[j];
-    // Filtered derivative of the measurement: backward Euler of s / (1 + Tf·s).
-    velocity_[j] = (tf * velocity_[j] + (y[j] - y_prev_[j])) / (tf + ts);
-    y_prev_[j] = y[j];
-    const double d_term =
-        options_.kd[j] * ((options_.reference_velocity ? dqr[j] : 0.0) - velocity_[j]);
-    const double integral = integral_[j] + ts * options_.ki[j] * e;
-    const double u = options_.kp[j] * e + integral + d_term + feed_forward_[j];
-    const double u_sat = std::clamp(u, -limit_[j], limit_[j]);
-    // Conditional integration: keep the old integral when saturated and e pushes further out.
-    const bool winding = u != u_sat && ((u > 0.0) == (e > 0.0)) && e != 0.0;
-    if (!(options_.anti_windup && winding)) integral_[j] = integral;
-    tau[j] = u_sat;
+    const double integral = pid_step(j, e, y[j]);
+    const double u =
+        options_.kp[j] * e + integral +
+        options_.kd[j] * ((options_.reference_velocity ? dqr[j] : 0.0) - velocity_[j]) +
+        feed_forward_[j];
+    tau[j] = saturate(j, u, e, integral);
   }
+}
+
+double PidController::pid_step(int j, double e, double y) {
+  const double ts = options_.sample_time, tf = options_.derivative_filter_time;
+  // Filtered derivative of the measurement: backward Euler of s / (1 + Tf·s).
+  velocity_[j] = (tf * velocity_[j] + (y - y_prev_[j])) / (tf + ts);
+  y_prev_[j] = y;
+  return integral_[j] + ts * options_.ki[j] * e;
+}
+
+double PidController::saturate(int j, double u, double e, double integral) {
+  const double u_sat = std::clamp(u, -limit_[j], limit_[j]);
+  // Conditional integration: keep the old integral when saturated and e pushes further out.
+  const bool winding = u != u_sat && ((u > 0.0) == (e > 0.0)) && e != 0.0;
+  if (!(options_.anti_windup && winding)) integral_[j] = integral;
+  return u_sat;
+}
+
+void PidController::update_inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>& qr,
+                                            const Eigen::Ref<const Eigen::VectorXd>& dqr,
+                                            const Eigen::Ref<const Eigen::VectorXd>& ddqr,
+                                            const Eigen::Ref<const Eigen::VectorXd>& y,
+                                            Eigen::Ref<Eigen::VectorXd> tau) {
+  const int n = model_.dof();
+  if (inertia_.size() != n) throw Error("computed-torque control: call reset() before update()");
+  for (int j = 0; j < n; ++j) {
+    const double e = qr[j] - y[j];
+    integral_next_[j] = pid_step(j, e, y[j]);
+    pid_[j] = options_.kp[j] * e + integral_next_[j] +
+              options_.kd[j] * ((options_.reference_velocity ? dqr[j] : 0.0) - velocity_[j]);
+    acceleration_[j] = ddqr[j] + pid_[j] / inertia_[j];
+  }
+  // The reference velocity in c and the friction: the measured one would bring its noise and,
+  // through sign(dq), torque chatter at every reversal (docs/methods/control.md).
+  rnea(model_, ws_, y, dqr, acceleration_, feed_forward_);
+  for (int j = 0; j < n; ++j)
+    tau[j] = saturate(j, feed_forward_[j], qr[j] - y[j], integral_next_[j]);
 }
 
 }  // namespace dynid

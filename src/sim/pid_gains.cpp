@@ -73,8 +73,23 @@ PidGains read_pid_gains(const std::string& path, const Model& model) {
                   "'; the gains are kp, ki, kd");
   }
   const int n = model.dof();
-  return {read_gain_list(doc, "kp", path, n), read_gain_list(doc, "ki", path, n),
-          read_gain_list(doc, "kd", path, n)};
+  PidGains out{read_gain_list(doc, "kp", path, n), read_gain_list(doc, "ki", path, n),
+               read_gain_list(doc, "kd", path, n), ""};
+  if (doc["controller"]) {
+    try {
+      out.controller = doc["controller"].as<std::string>();
+    } catch (const YAML::Exception&) {
+      throw Error("gains file " + path + ": 'controller' must be a name, e.g. pid");
+    }
+  }
+  return out;
+}
+
+std::string gains_file_for_run(const std::string& run_path) {
+  const std::string suffix = ".csv";
+  const bool csv = run_path.size() > suffix.size() &&
+                   run_path.compare(run_path.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return (csv ? run_path.substr(0, run_path.size() - suffix.size()) : run_path) + ".gains.json";
 }
 
 void write_pid_gains(const std::string& path, const Model& model, const PidOptions& pid,
@@ -85,7 +100,9 @@ void write_pid_gains(const std::string& path, const Model& model, const PidOptio
   std::vector<std::string> joints;
   for (const Joint& j : model.joints) joints.push_back(j.name);
   nlohmann::json out;
-  out["controller"] = pid.feed_forward == FeedForward::kNone ? "pid" : "pid-feedforward";
+  out["controller"] = pid.feed_forward == FeedForward::kNone              ? "pid"
+                      : pid.feed_forward == FeedForward::kInverseDynamics ? "computed-torque"
+                                                                          : "pid-feedforward";
   out["joints"] = joints;
   out["kp"] = list(pid.kp);
   out["ki"] = list(pid.ki);

@@ -171,8 +171,13 @@ ClosedLoopResult simulate_reference(const Model& model, const Eigen::Ref<const E
   const Reference ref = periodic_reference(t, q, dq, ddq);
   check_reference_rows(model, ref.q);
   options.plant.dt = info.mean_period;
+  const Model& controller_model = options.controller_model ? *options.controller_model : model;
+  if (controller_model.dof() != model.dof())
+    throw Error("simulate: the controller's model has " + std::to_string(controller_model.dof()) +
+                " joints but the robot has " + std::to_string(model.dof()) +
+                "; give parameters identified on this robot");
   auto plant = make_plant(model, options.plant);
-  PidController pid(model,
+  PidController pid(controller_model,
                     simulation_pid_options(model, q.row(0).transpose(), info.rate_hz(), options));
   if (controller_used != nullptr) *controller_used = pid.options();
   Sensors sensors(model, options.sensors);
@@ -186,15 +191,20 @@ SimulationValidation validate_run_by_simulation(
     const Eigen::Ref<const Eigen::MatrixXd>& q, const Eigen::Ref<const Eigen::MatrixXd>& dq,
     const Eigen::Ref<const Eigen::MatrixXd>& ddq,
     const Eigen::Ref<const Eigen::MatrixXd>& q_measured,
-    const Eigen::Ref<const Eigen::MatrixXd>& tau_measured, const PlantOptions& plant) {
+    const Eigen::Ref<const Eigen::MatrixXd>& tau_measured, const PlantOptions& plant,
+    FeedForward feed_forward, const PidGains& gains) {
   const SamplingInfo info = require_uniform_sampling(t, 1e-6, "validation by simulation");
   const Reference ref = periodic_reference(t, q, dq, ddq);
   SimulationValidationOptions options;
   options.plant = plant;
   options.plant.dt = info.mean_period;
   options.skip_samples = std::min<long>(ref.t.size(), q_measured.rows() / 2);
+  SimulateOptions controller;
+  controller.feed_forward = feed_forward;
+  controller.gains = gains;
   return validate_by_simulation(
-      identified, ref, default_pid_options(identified, q.row(0).transpose(), info.rate_hz()),
+      identified, ref,
+      simulation_pid_options(identified, q.row(0).transpose(), info.rate_hz(), controller),
       q_measured, tau_measured, options);
 }
 

@@ -83,8 +83,9 @@ TEST_F(SimulateCli, DefaultControllerIsFeedForwardAndBadInputIsOneErrorLine) {
   const auto usage = run("simulate --robot planar2 --trajectory " + work("traj.csv") + " --out " +
                          work("bad.csv") + " --controller lqr");
   EXPECT_EQ(usage.code, 2);
-  EXPECT_NE(usage.err.find("--controller must be pid or pid-feedforward, not 'lqr'"),
-            std::string::npos)
+  EXPECT_NE(
+      usage.err.find("--controller must be pid, pid-feedforward or computed-torque, not 'lqr'"),
+      std::string::npos)
       << usage.err;
 }
 

@@ -70,6 +70,29 @@ TEST(ErrorStatistics, DistinguishesGaussianFromUniform) {
   EXPECT_LT(su.ks_p_value, 1e-6);
 }
 
+// Uniform on [−1, 1] has density 1/2: with 20 bins over its range, each bin holds ~1000 of 20000
+// samples (binomial σ ≈ 31, i.e. 3 % of the density); the density integrates to 1 by construction
+// and the Gaussian column is N(μ, σ²) of the sample at the centres.
+TEST(ErrorHistogram, UniformDensityAndGaussianBeside) {
+  const int n = 20000;
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Eigen::VectorXd u(n);
+  for (int i = 0; i < n; ++i) u[i] = uniform(rng);
+  const ErrorHistogram h = error_histogram(u, 20);
+  ASSERT_EQ(h.center.size(), 20);
+  const double width = h.center[1] - h.center[0];
+  EXPECT_NEAR(h.density.sum() * width, 1.0, 1e-12);
+  for (int b = 0; b < 20; ++b) EXPECT_NEAR(h.density[b], 0.5, 5 * 0.5 * 31.0 / 1000.0) << b;
+  const ErrorStatistics s = error_statistics(u);
+  const double z = (h.center[3] - s.mean) / s.std;
+  EXPECT_NEAR(h.gaussian[3], std::exp(-0.5 * z * z) / (s.std * std::sqrt(2 * kPi)), 1e-12);
+  EXPECT_THROW(error_histogram(u, 0), Error);
+  const ErrorHistogram c = error_histogram(Eigen::VectorXd::Constant(4, 2.0), 3);
+  EXPECT_NEAR(c.density.sum() * (c.center[1] - c.center[0]), 1.0, 1e-12);
+  EXPECT_EQ(c.gaussian.sum(), 0.0);
+}
+
 TEST(ErrorStatistics, RejectsBadInput) {
   EXPECT_THROW(error_statistics(Eigen::VectorXd::Zero(1)), Error);
   Eigen::VectorXd e = Eigen::VectorXd::Zero(5);

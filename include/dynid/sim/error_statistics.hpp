@@ -25,6 +25,19 @@ struct ErrorStatistics {
 /// Throws dynid::Error if e has fewer than 2 samples or a non-finite value.
 ErrorStatistics error_statistics(const Eigen::Ref<const Eigen::VectorXd>& e);
 
+/// Histogram of an error signal as an estimate of its PDF, beside the Gaussian of the same mean and
+/// std (seed 2 §3.5, Fig. 8).
+struct ErrorHistogram {
+  Eigen::VectorXd center;    ///< bin centres [unit of e], `bins` equal bins over [min e, max e]
+  Eigen::VectorXd density;   ///< count / (N · bin width): integrates to 1 [1/unit of e]
+  Eigen::VectorXd gaussian;  ///< N(μ, σ²) density at the centres (0 when σ = 0)
+};
+
+/// Histogram of e (size N ≥ 2, finite) with `bins` ≥ 1 equal bins over [min e, max e] (a constant
+/// e gets one bin of width 1 around it). Throws dynid::Error for fewer than 2 samples, a non-finite
+/// value or bins < 1.
+ErrorHistogram error_histogram(const Eigen::Ref<const Eigen::VectorXd>& e, int bins);
+
 /// Kolmogorov survival function Q_KS(λ) = 2 Σ_{k≥1} (−1)^{k−1} exp(−2k²λ²) (Q(0) = 1).
 double kolmogorov_survival(double lambda);
 

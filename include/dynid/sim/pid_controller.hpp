@@ -11,6 +11,11 @@ namespace dynid {
 enum class FeedForward {
   kNone,            ///< pure PID
   kComputedTorque,  ///< tau_ff = rnea(model, qr, dqr, ddqr) with joint terms (seed 2 §3.6)
+  /// Computed-torque law (seed 2 §3.6; docs/methods/control.md): the PID output, divided by the
+  /// joint inertias D it was tuned for, is an acceleration correction, and the model turns it into
+  /// torque at the measured position: tau = rnea(model; y, dqr, ddqr + D⁻¹·u_pid)
+  ///   = M(y)·(ddqr + D⁻¹·u_pid) + c(y, dqr) + g(y) + friction(dqr).
+  kInverseDynamics,
 };
 
 /// Options of the discrete joint PID controller. Gains are per joint; sizes must equal the DoF.
@@ -28,6 +33,9 @@ struct PidOptions {
   bool anti_windup = true;  ///< conditional integration: the integral is frozen while the output
                             ///< is saturated and the error would drive it further out
   FeedForward feed_forward = FeedForward::kNone;  ///< feed-forward torque
+  Eigen::VectorXd inertia;  ///< kInverseDynamics only: D, per joint the inertia the gains were
+                            ///< tuned for [kg·m² or kg]; empty = diag M(y0) of the controller's
+                            ///< model at reset(), so near y0 the loop has the PID's bandwidth
 };
 
 /// Discrete PID on every joint, derivative on the measurement through a first-order filter,
@@ -36,15 +44,20 @@ struct PidOptions {
 ///   v_k = (Tf·v_{k−1} + y_k − y_{k−1}) / (Tf + Ts)     (backward-Euler of s/(1 + Tf·s))
 ///   I_k = I_{k−1} + Ts·Ki·e_k                         (frozen by anti-windup, see PidOptions)
 ///   u_k = Kp·e_k + I_k + Kd·(dqr_k − v_k) + tau_ff_k,  tau_k = clamp(u_k, −L, L).
-/// Its continuous limit is u = (Kp + Ki/s)·e + Kd·(s·r − s/(1 + Tf·s)·y) + tau_ff.
+/// Its continuous limit is u = (Kp + Ki/s)·e + Kd·(s·r − s/(1 + Tf·s)·y) + tau_ff. With
+/// FeedForward::kInverseDynamics the PID part p_k = Kp·e_k + I_k + Kd·(dqr_k − v_k) instead enters
+/// u_k = rnea(model; y_k, dqr_k, ddqr_k + D⁻¹·p_k) (the model is the one given to the
+/// constructor, e.g. identified_model(): its base parameters give M and the other terms).
 class PidController {
  public:
   /// Checks the options against `model` (copied for the feed-forward and limits). Throws
-  /// dynid::Error naming the field at fault (sizes, negative or non-finite gains, Ts ≤ 0).
+  /// dynid::Error naming the field at fault (sizes, negative or non-finite gains, Ts ≤ 0, an
+  /// inertia that is not finite and > 0).
   PidController(const Model& model, const PidOptions& options);
 
   /// Clears the integral and the filter; y0 (size n) is the first measurement, so the filtered
-  /// velocity starts at 0 without a derivative kick.
+  /// velocity starts at 0 without a derivative kick. kInverseDynamics without options.inertia:
+  /// D = diag M(y0); throws dynid::Error when an entry is not > 0 (a joint moving no mass).
   void reset(const Eigen::Ref<const Eigen::VectorXd>& y0);
 
   /// One controller sample: from the reference (qr, dqr, ddqr) and the measured position y (all
@@ -56,6 +69,8 @@ class PidController {
 
   /// The integral state I_k (size n) [N·m].
   const Eigen::VectorXd& integral() const { return integral_; }
+  /// D of kInverseDynamics (size n) [kg·m²]; empty before reset() when not given.
+  const Eigen::VectorXd& inertia() const { return inertia_; }
   /// The effective saturation limits (size n) [N·m].
   const Eigen::VectorXd& effort_limit() const { return limit_; }
   /// Controller period Ts [s].
@@ -64,10 +79,22 @@ class PidController {
   const PidOptions& options() const { return options_; }
 
  private:
+  // Filter step of joint j for measurement y; returns the candidate integral I_k for error e.
+  double pid_step(int j, double e, double y);
+  // Clamps u to the limit of joint j and keeps `integral` unless anti-windup freezes it.
+  double saturate(int j, double u, double e, double integral);
+  void update_inverse_dynamics(const Eigen::Ref<const Eigen::VectorXd>& qr,
+                               const Eigen::Ref<const Eigen::VectorXd>& dqr,
+                               const Eigen::Ref<const Eigen::VectorXd>& ddqr,
+                               const Eigen::Ref<const Eigen::VectorXd>& y,
+                               Eigen::Ref<Eigen::VectorXd> tau);
+
   Model model_;
   PidOptions options_;
   Workspace ws_;
   Eigen::VectorXd limit_, integral_, y_prev_, velocity_, feed_forward_;
+  Eigen::VectorXd inertia_, integral_next_, pid_, acceleration_;  // kInverseDynamics
+  Eigen::MatrixXd mass_;                                          // M(y0) for the default D
 };
 
 }  // namespace dynid

@@ -1,5 +1,8 @@
 #pragma once
 
+#include <optional>
+#include <string>
+
 #include <Eigen/Core>
 
 #include "dynid/sim/closed_loop.hpp"
@@ -25,9 +28,10 @@ PidOptions default_pid_options(const Model& model, const Eigen::Ref<const Eigen:
 
 /// Per-joint PID gains given by the user (e.g. read_pid_gains()); empty kp = the default rule.
 struct PidGains {
-  Eigen::VectorXd kp;  ///< proportional gains [N·m/rad or N/m], size n
-  Eigen::VectorXd ki;  ///< integral gains [N·m/(rad·s)], size n
-  Eigen::VectorXd kd;  ///< derivative gains [N·m·s/rad], size n
+  Eigen::VectorXd kp;      ///< proportional gains [N·m/rad or N/m], size n
+  Eigen::VectorXd ki;      ///< integral gains [N·m/(rad·s)], size n
+  Eigen::VectorXd kd;      ///< derivative gains [N·m·s/rad], size n
+  std::string controller;  ///< the controller a written gains file names ("pid", ...); may be empty
 };
 
 /// Options of simulate_reference().
@@ -37,6 +41,9 @@ struct SimulateOptions {
   ClosedLoopOptions loop;  ///< periods (25), truth recording
   FeedForward feed_forward = FeedForward::kComputedTorque;  ///< kNone = plain PID (seed 2 §2.2)
   PidGains gains;  ///< user gains; empty kp = default_pid_options() for the position delay
+  /// The model inside the controller (feed-forward, computed-torque law), e.g. identified_model()
+  /// of a result; empty = the plant's model. Same joints as the plant's model.
+  std::optional<Model> controller_model;
 };
 
 /// The controller simulate_reference() runs for a reference starting at q0 sampled at rate_hz:
@@ -53,7 +60,8 @@ PidOptions simulation_pid_options(const Model& model, const Eigen::Ref<const Eig
 /// reference row far outside the rest of the reference, and when the run is not a tracking of the
 /// reference: a non-finite logged value (noise that overflows, a plant gone unstable) or a joint
 /// leaving [P1 − span − π, P99 + span + π], P1/P99 the reference's percentiles, span = P99 − P1.
-/// When controller_used is not null it receives the controller options the run used.
+/// When controller_used is not null it receives the controller options the run used. Throws
+/// dynid::Error when options.controller_model has another joint count than `model`.
 ClosedLoopResult simulate_reference(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& t,
                                     const Eigen::Ref<const Eigen::MatrixXd>& q,
                                     const Eigen::Ref<const Eigen::MatrixXd>& dq,
@@ -62,13 +70,16 @@ ClosedLoopResult simulate_reference(const Model& model, const Eigen::Ref<const E
 
 /// Validation by simulation (seed 2 §3.5) of a measured run made with simulate_reference()'s
 /// controller: simulates `identified` under the same reference (one period, as for
-/// simulate_reference) and default_pid_options(), and compares with q_measured, tau_measured
-/// (N×n from t_0 of the reference at its rate). The first period is left out of the statistics.
+/// simulate_reference) and the controller of simulation_pid_options() with `feed_forward` and
+/// `gains` (the run's own loop; kInverseDynamics uses `identified` as the controller's model), and
+/// compares with q_measured, tau_measured (N×n from t_0 of the reference at its rate). The first
+/// period is left out of the statistics.
 SimulationValidation validate_run_by_simulation(
     const Model& identified, const Eigen::Ref<const Eigen::VectorXd>& t,
     const Eigen::Ref<const Eigen::MatrixXd>& q, const Eigen::Ref<const Eigen::MatrixXd>& dq,
     const Eigen::Ref<const Eigen::MatrixXd>& ddq,
     const Eigen::Ref<const Eigen::MatrixXd>& q_measured,
-    const Eigen::Ref<const Eigen::MatrixXd>& tau_measured, const PlantOptions& plant);
+    const Eigen::Ref<const Eigen::MatrixXd>& tau_measured, const PlantOptions& plant,
+    FeedForward feed_forward = FeedForward::kComputedTorque, const PidGains& gains = {});
 
 }  // namespace dynid
