@@ -55,6 +55,8 @@ struct IdentifyCliOptions {
   int joint = 0;                       // --joint (gravity, friction, decoupled), 1-based
   std::string params;                  // --params (friction: compensation model)
   bool physical = false;               // --physical
+
+  std::vector<std::string> friction_known;  // --friction-known, repeatable
 };
 
 // The run named by `flag` must be a readable file (so the error names the flag the user gave).
@@ -228,7 +230,8 @@ nlohmann::json echo(const IdentifyCliOptions& o) {
           {"columns", o.columns},
           {"torque_scale", o.torque_scale},
           {"rows", o.rows},
-          {"time", o.time}};
+          {"time", o.time},
+          {"friction_known", o.friction_known}};
 }
 
 // The flags that say how to read a run (identify, validate).
@@ -410,6 +413,18 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   if (o.model == "integral" && o.stream) {
     throw UsageError("--stream is for the differential model; drop it with --model integral");
   }
+  if (!o.friction_known.empty()) {
+    if (o.model != "differential" || o.stream) {
+      throw UsageError(
+          "--friction-known is for the differential model in memory; drop it, or "
+          "drop --model/--stream");
+    }
+    if (cmd.count("--friction") && o.friction != "none") {
+      throw UsageError("--friction-known replaces the friction columns; drop --friction");
+    }
+    o.friction = "none";  // only the rigid body (and armature) is estimated (seed 2 §3.4)
+    for (const auto& f : o.friction_known) require_readable(f, "--friction-known");
+  }
   IdentifyOptions options = library_options(o);
   const RunFileOptions file = run_file_options(o.columns, o.rate, o.torque_scale, o.rows, o.time);
   if (!o.history.empty() && options.estimator != IdentificationEstimator::kRls) {
@@ -445,6 +460,14 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   } else {
     // Each run read on its own (same column mapping, window and torque scale for every run).
     for (const auto& run : o.runs) records.push_back(read_joint_record(run, model, file, &read));
+    for (const auto& f : o.friction_known) {
+      const IdentifiedResultFile known = read_identification_result(f);
+      if (!known.robot.empty() && known.robot != model.name) {
+        throw Error("--friction-known '" + f + "' was identified on robot '" + known.robot +
+                    "' but --robot gives '" + model.name + "'; give a result of this robot");
+      }
+      add_known_friction(options.known_friction, model, known.names, known.values, f);
+    }
     result = identify(model, records, options);
     for (size_t i = 0; i < result.runs.size(); ++i) result.runs[i].file = o.runs[i];
   }
@@ -720,6 +743,13 @@ void add_identify_command(CLI::App& app) {
   cmd->add_option("--params", o->params,
                   "friction: result.json whose identified model compensates inertia and gravity "
                   "(default: the robot's nominal model)");
+  cmd->add_option("--friction-known", o->friction_known,
+                  "Result JSON of identify --model friction or decoupled (repeat per joint): its "
+                  "asymmetric friction is subtracted from the measured torque and only the "
+                  "rigid-body base parameters (and armature) are estimated (Bona, Curatella 2005, "
+                  "section 3.4)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_flag("--physical", o->physical,
                 "Also fit physically consistent standard parameters (mass > 0, realisable "
                 "inertia, friction >= 0; log-Cholesky, Rucker and Wensing 2022) to the estimate");

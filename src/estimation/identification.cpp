@@ -446,6 +446,8 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
   IdentificationResult result;
   const bool coupling = options.coupling && !coupled_motors(model).empty();
   const bool integral = options.model == IdentificationModel::kIntegral;
+  if (integral && !options.known_friction.empty())
+    throw UsageError("known friction is subtracted from joint torques: use the differential model");
   if (integral) {
     std::ostringstream m;
     m << "integral (energy) model, "
@@ -484,6 +486,7 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
       threshold = zero_velocity_threshold(options, processed, "removed", choices);
       blocks.push_back(
           differential_equations(model, options.layout, coupling, processed, threshold));
+      subtract_known_friction(model, options.known_friction, processed, blocks.back());
     }
     RunSummary run;
     run.samples = processed.record.t.size();

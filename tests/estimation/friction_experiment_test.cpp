@@ -3,13 +3,16 @@
 // Coulomb level differs by direction: Fcp = Fc + Fo, Fcn = Fc − Fo), with encoder and torque noise,
 // prepared by preprocess() with its defaults; inertia and gravity compensated with the plant's
 // model. Fixed seeds.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include <gtest/gtest.h>
 
 #include "dynid/common/error.hpp"
 #include "dynid/estimation/friction_experiment.hpp"
 #include "dynid/excitation/bang_bang_trajectory.hpp"
+#include "dynid/excitation/fourier_trajectory.hpp"
 #include "dynid/excitation/trajectory_samples.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/sim/simulate_reference.hpp"
@@ -110,6 +113,83 @@ TEST(FrictionExperiment, OneDirectionOnlyIsRefused) {
     EXPECT_NE(std::string(e.what()).find("both directions"), std::string::npos) << e.what();
   }
   EXPECT_THROW(fit_friction_experiment(m, {full}, 2), UsageError);
+}
+
+}  // namespace
+}  // namespace dynid
+
+namespace dynid {
+namespace {
+
+// Seed 2 §3.4: with the friction known from before subtracted, only the rigid body is estimated.
+// planar2 with viscous, Coulomb and offset friction in closed loop (native plant, sensor noise);
+// the known friction is the plant's, written in the asymmetric form of eq. 2 (Fcp = Fc + Fo,
+// Fcn = Fc − Fo). Every rigid-body base parameter falls inside its 99.9 % interval; without the
+// subtraction (negative control) the friction torque is fitted by the inertial columns and some
+// fall far outside.
+TEST(KnownFriction, SubtractedFrictionLeavesRigidBodyInsideIntervals) {
+  const Model plant = testing::planar2_with_friction();
+  constexpr double kRate = 200.0;
+  const TrajectorySamples tr =
+      sample_trajectory(FourierTrajectory(testing::planar2_reference()), kRate, false);
+  const JointRecord run =
+      testing::closed_loop_run(plant, tr, testing::noisy_sensors(1e-4, 0.05, 3, 5));
+  IdentifyOptions io;
+  io.layout = ParameterLayout::rigid();
+  io.signal.torque_time_offset = 0.5 / kRate;
+  std::vector<std::string> names;
+  std::vector<double> values;
+  for (int j = 0; j < 2; ++j) {
+    const JointFriction& f = plant.joints[j].friction;
+    const std::string s = std::to_string(j + 1);
+    names.insert(names.end(), {"Fvp" + s, "Fvn" + s, "Fcp" + s, "Fcn" + s});
+    values.insert(values.end(), {f.Fv, f.Fv, f.Fc + f.Fo, f.Fc - f.Fo});
+  }
+  const Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(values.data(), 8);
+  auto outside = [&](const IdentificationResult& r) {
+    const Eigen::VectorXd truth = r.base.reduce(io.layout.parameters(plant));
+    int count = 0;
+    for (size_t i = 0; i < r.names.size(); ++i) {
+      const auto k =
+          std::find(r.base.names.begin(), r.base.names.end(), r.names[i]) - r.base.names.begin();
+      const bool in = truth[k] >= r.estimate.ci_lower[static_cast<Eigen::Index>(i)] &&
+                      truth[k] <= r.estimate.ci_upper[static_cast<Eigen::Index>(i)];
+      std::printf("%-6s truth %9.4f estimate %9.4f [%9.4f, %9.4f]%s\n", r.names[i].c_str(),
+                  truth[k], r.estimate.x[static_cast<Eigen::Index>(i)],
+                  r.estimate.ci_lower[static_cast<Eigen::Index>(i)],
+                  r.estimate.ci_upper[static_cast<Eigen::Index>(i)], in ? "" : "  OUTSIDE");
+      count += in ? 0 : 1;
+    }
+    return count;
+  };
+  IdentifyOptions with = io;
+  add_known_friction(with.known_friction, plant, names, v, "truth");
+  const IdentificationResult known = identify(plant, run, with);
+  ASSERT_GE(known.names.size(), 3u);
+  EXPECT_EQ(outside(known), 0);
+  const IdentificationResult ignored = identify(plant, run, io);
+  EXPECT_GE(outside(ignored), 2);
+}
+
+TEST(KnownFriction, IncompleteOrRepeatedJointIsRefused) {
+  const Model plant = testing::planar2_with_friction();
+  KnownFriction f;
+  EXPECT_THROW(
+      add_known_friction(f, plant, {"Fvp1", "Fvn1", "Fcp1"}, Eigen::Vector3d(1, 1, 1), "a.json"),
+      Error);
+  KnownFriction g;
+  add_known_friction(g, plant, {"Fvp2", "Fvn2", "Fcp2", "Fcn2"}, Eigen::Vector4d(1, 1, 1, 1),
+                     "a.json");
+  EXPECT_TRUE(g.given[1]);
+  EXPECT_FALSE(g.given[0]);
+  EXPECT_THROW(add_known_friction(g, plant, {"Fvp2", "Fvn2", "Fcp2", "Fcn2"},
+                                  Eigen::Vector4d(1, 1, 1, 1), "b.json"),
+               Error);
+  EXPECT_THROW(add_known_friction(g, plant, {"Fvp3", "Fvn3", "Fcp3", "Fcn3"},
+                                  Eigen::Vector4d(1, 1, 1, 1), "c.json"),
+               Error);
+  KnownFriction h;
+  EXPECT_THROW(add_known_friction(h, plant, {"ZZ1"}, Eigen::VectorXd::Ones(1), "d.json"), Error);
 }
 
 }  // namespace

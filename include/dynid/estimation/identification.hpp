@@ -7,6 +7,7 @@
 
 #include "dynid/estimation/estimate.hpp"
 #include "dynid/estimation/integral_options.hpp"
+#include "dynid/estimation/known_friction.hpp"
 #include "dynid/estimation/outlier_options.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
 #include "dynid/model/model.hpp"
@@ -98,6 +99,9 @@ struct IdentifyOptions {
   IntegralOptions integral;   ///< intervals and quadrature of the integral model
   BaseParameterOptions base;  ///< base-parameter computation (layout is overwritten)
   OutlierOptions outliers;    ///< gross torque outliers: report or drop (outliers.hpp)
+  /// Friction identified before, subtracted from the measured torque of the differential model
+  /// (seed 2 §3.4); give a layout without those friction columns. Empty = none.
+  KnownFriction known_friction;
   /// With the RLS estimator: keep the estimate and σ after every equation (history_* of the
   /// result; memory grows with the rows).
   bool record_history = false;
