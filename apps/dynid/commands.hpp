@@ -39,4 +39,7 @@ void add_average_command(CLI::App& app);
 /// `dynid payload`: a gripped load's parameters from a wrist force/torque sensor (cmd_payload.cpp).
 void add_payload_command(CLI::App& app);
 
+/// `dynid export`: physically consistent parameters written as URDF (cmd_export.cpp).
+void add_export_command(CLI::App& app);
+
 }  // namespace dynid::cli
