@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -20,9 +21,14 @@ namespace dynid {
 
 namespace {
 
+// The shortest decimal that reads back as the same double (0.3, not 0.29999999999999999).
 std::string number(double x) {
   char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.17g", x);
+  if (x == 0.0) x = 0.0;  // no "-0"
+  for (int digits = 15; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof(buf), "%.*g", digits, x);
+    if (std::strtod(buf, nullptr) == x) break;
+  }
   return buf;
 }
 
@@ -216,6 +222,11 @@ UrdfExport export_urdf(const Model& nominal, const std::vector<std::string>& nam
     if (label == "Iam" || label == "Fvm" || label == "Fcm") {
       out.not_in_urdf.push_back(v + " (coupled motor term: URDF has no transmission dynamics)");
     }
+  }
+  if (nominal.gravity != Eigen::Vector3d(0.0, 0.0, -9.81)) {
+    out.not_in_urdf.push_back("gravity = (" + number(nominal.gravity.x()) + ", " +
+                              number(nominal.gravity.y()) + ", " + number(nominal.gravity.z()) +
+                              ") m/s^2 (URDF has no gravity; set it in the simulator)");
   }
   const bool edit = ends_with(nominal.source, ".urdf");
   const std::string xml = edit ? read_robot_file(nominal.source) : to_urdf(out.model);

@@ -28,7 +28,7 @@ struct UrdfExport {
   std::string text;  ///< the URDF
   /// Identified terms URDF has no element for, as `name = value (reason)`: armature Ia (no URDF
   /// element), offset Fo, asymmetric friction (written as the mean of both directions), coupled
-  /// motor terms Iam/Fvm/Fcm.
+  /// motor terms Iam/Fvm/Fcm, and a gravity other than (0, 0, −9.81).
   std::vector<std::string> not_in_urdf;
   /// Links fixed to a moving link whose <inertial> was removed: the identification sees the rigid
   /// group as one body, whose identified inertia goes to the moving link.
