@@ -51,4 +51,7 @@ void add_compare_control_command(CLI::App& app);
 /// dynid::Error naming the file (unreadable, another robot, a name that is no base parameter).
 Model model_from_result(const Model& model, const std::string& params);
 
+/// `dynid export`: physically consistent parameters written as URDF (cmd_export.cpp).
+void add_export_command(CLI::App& app);
+
 }  // namespace dynid::cli

@@ -41,6 +41,16 @@ std::string number(double x) {
 
 }  // namespace
 
+ComInertial com_inertial(const LinkParams& p) {
+  ComInertial out;
+  out.mass = p(9);
+  if (out.mass > 0.0) out.com = p.segment<3>(6) / out.mass;
+  const Eigen::Vector3d& c = out.com;
+  out.inertia = inertia_about_origin(p) -
+                out.mass * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
+  return out;
+}
+
 std::string to_urdf(const Model& model, const UrdfWriteOptions& options) {
   std::ostringstream out;
   out << "<?xml version=\"1.0\"?>\n<robot name=\"" << (model.name.empty() ? "robot" : model.name)
@@ -60,11 +70,9 @@ std::string to_urdf(const Model& model, const UrdfWriteOptions& options) {
     out << "  <link name=\"" << link_name(j) << "\">\n";
     if (m > 0.0 || !p.head<6>().isZero(0.0)) {
       // A massless link can still carry rotational inertia (e.g. a rotor-only link 1).
-      const Eigen::Vector3d c =
-          m > 0.0 ? Eigen::Vector3d(p.segment<3>(6) / m) : Eigen::Vector3d::Zero();
-      const Eigen::Matrix3d I_C =
-          inertia_about_origin(p) -
-          m * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
+      const ComInertial inertial = com_inertial(p);
+      const Eigen::Vector3d& c = inertial.com;
+      const Eigen::Matrix3d& I_C = inertial.inertia;
       out << "    <inertial>\n      <origin xyz=\"" << vec3(c) << "\" rpy=\"0 0 0\"/>\n"
           << "      <mass value=\"" << number(m) << "\"/>\n"
           << "      <inertia ixx=\"" << number(I_C(0, 0)) << "\" ixy=\"" << number(I_C(0, 1))

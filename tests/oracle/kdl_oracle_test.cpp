@@ -11,26 +11,16 @@
 #include "dynid/dynamics/rnea.hpp"
 #include "dynid/io/urdf_writer.hpp"
 #include "dynid/model/robots.hpp"
+#include "oracle/kdl_support.hpp"
 #include "oracle/oracle_support.hpp"
 #include "support/random_models.hpp"
 
 namespace dynid {
 namespace {
 
+using testing::kdl_indices;
 using testing::random_tree;
 using testing::random_vector;
-
-// Index of each KDL tree joint (q_nr) in dynid's joint order, matched by joint name.
-std::vector<unsigned> kdl_indices(const KDL::Tree& tree, const Model& model) {
-  std::map<std::string, unsigned> by_name;
-  for (const auto& [name, element] : tree.getSegments()) {
-    const KDL::Joint& joint = element.segment.getJoint();
-    if (joint.getType() != KDL::Joint::None) by_name[joint.getName()] = GetTreeElementQNr(element);
-  }
-  std::vector<unsigned> out;
-  for (const Joint& j : model.joints) out.push_back(by_name.at(j.name));
-  return out;
-}
 
 class KdlTreeOracle : public ::testing::TestWithParam<unsigned> {};
 

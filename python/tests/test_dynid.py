@@ -1,0 +1,117 @@
+"""Tests of the dynid Python module (issue 15 item 4). Oracles: the closed-form planar 2R arm
+(written out here in NumPy), NumPy's own rank, and identification from torques of that closed
+form with noise, the truth inside the predicted intervals."""
+import numpy as np
+import pytest
+
+import dynid
+
+# examples/robots/planar2.yaml: gravity -9.81 along y, link lengths 1.0, centres of mass on x.
+M1, LC1, I1 = 2.0, 0.5, 1.0 / 6.0
+M2, LC2, I2 = 1.5, 0.4, 0.08
+L1, G = 1.0, 9.81
+
+
+def planar2_torques(q, dq, ddq):
+    """Closed-form inverse dynamics of the planar 2R arm (Spong, Hutchinson, Vidyasagar ch. 7)."""
+    c2, s2 = np.cos(q[:, 1]), np.sin(q[:, 1])
+    m11 = I1 + M1 * LC1**2 + I2 + M2 * (L1**2 + LC2**2 + 2 * L1 * LC2 * c2)
+    m12 = I2 + M2 * (LC2**2 + L1 * LC2 * c2)
+    m22 = I2 + M2 * LC2**2
+    h = M2 * L1 * LC2 * s2
+    g1 = (M1 * LC1 + M2 * L1) * G * np.cos(q[:, 0]) + M2 * LC2 * G * np.cos(q[:, 0] + q[:, 1])
+    g2 = M2 * LC2 * G * np.cos(q[:, 0] + q[:, 1])
+    tau1 = m11 * ddq[:, 0] + m12 * ddq[:, 1] - h * (2 * dq[:, 0] * dq[:, 1] + dq[:, 1] ** 2) + g1
+    tau2 = m12 * ddq[:, 0] + m22 * ddq[:, 1] + h * dq[:, 0] ** 2 + g2
+    return np.column_stack([tau1, tau2])
+
+
+def fourier_run(seed, samples=1500, rate=100.0):
+    rng = np.random.default_rng(seed)
+    t = np.arange(samples) / rate
+    a = rng.uniform(0.3, 0.8, size=(3, 2))
+    w = 2 * np.pi * np.array([0.2, 0.45, 0.7])
+    q = sum(a[k] * np.sin(w[k] * t)[:, None] for k in range(3))
+    dq = sum(a[k] * w[k] * np.cos(w[k] * t)[:, None] for k in range(3))
+    ddq = sum(-a[k] * w[k] ** 2 * np.sin(w[k] * t)[:, None] for k in range(3))
+    return t, q, dq, ddq
+
+
+@pytest.fixture(scope="module")
+def planar2():
+    return dynid.load_model("planar2")
+
+
+def test_model_properties(planar2):
+    assert planar2.dof == 2
+    assert planar2.joint_names == ["shoulder", "elbow"]
+    assert planar2.standard_parameter_names[:3] == ["XX1", "XY1", "XZ1"]
+    assert planar2.summary()["name"] == "planar2"
+    assert "planar2" in repr(planar2)
+
+
+def test_inverse_dynamics_matches_the_closed_form(planar2):
+    rng = np.random.default_rng(1)
+    q, dq, ddq = (rng.uniform(-2, 2, size=(50, 2)) for _ in range(3))
+    tau = dynid.inverse_dynamics(planar2, q, dq, ddq)
+    assert tau.shape == (50, 2)
+    np.testing.assert_allclose(tau, planar2_torques(q, dq, ddq), rtol=1e-12, atol=1e-12)
+
+
+def test_regressor_times_standard_parameters_is_the_inverse_dynamics(planar2):
+    rng = np.random.default_rng(2)
+    q, dq, ddq = (rng.uniform(-2, 2, size=(20, 2)) for _ in range(3))
+    y, names = dynid.regressor(planar2, q, dq, ddq, armature=False, viscous=False,
+                               coulomb=False, offset=False)
+    assert y.shape == (40, 20) and names == planar2.standard_parameter_names
+    tau = (y @ planar2.standard_parameters).reshape(20, 2)  # sample-major rows
+    np.testing.assert_allclose(tau, planar2_torques(q, dq, ddq), rtol=1e-12, atol=1e-12)
+
+
+def test_base_parameter_rank_is_the_rank_of_the_sampled_regressor(planar2):
+    base = dynid.base_parameters(planar2, armature=False, viscous=False, coulomb=False,
+                                 offset=False)
+    rng = np.random.default_rng(3)
+    q, dq, ddq = (rng.uniform(-3, 3, size=(200, 2)) for _ in range(3))
+    y, _ = dynid.regressor(planar2, q, dq, ddq, armature=False, viscous=False, coulomb=False,
+                           offset=False)
+    assert base["rank"] == np.linalg.matrix_rank(y) == len(base["base_parameters"])
+    # W theta = W_1 (theta_1 + K_d theta_2)
+    theta = planar2.standard_parameters
+    theta_b = theta[base["base_indices"]] + base["K_d"] @ theta[base["dependent_indices"]]
+    np.testing.assert_allclose(y[:, base["base_indices"]] @ theta_b, y @ theta, atol=1e-10)
+
+
+def test_identify_recovers_the_closed_form_arm_within_its_intervals(planar2):
+    t, q, dq, ddq = fourier_run(4)
+    rng = np.random.default_rng(5)
+    tau = planar2_torques(q, dq, ddq) + rng.normal(0.0, 0.05, size=q.shape)
+    options = dict(armature=False, viscous=False, coulomb=False, offset=False, filter=False)
+    result = dynid.identify(planar2, t, q, tau, dq=dq, ddq=ddq, **options)
+    base = dynid.base_parameters(planar2, armature=False, viscous=False, coulomb=False,
+                                 offset=False)
+    theta = planar2.standard_parameters
+    truth = theta[base["base_indices"]] + base["K_d"] @ theta[base["dependent_indices"]]
+    names = [p["name"] for p in base["base_parameters"]]
+    assert [p["name"] for p in result["parameters"]] == names
+    for p, x in zip(result["parameters"], truth):
+        assert p["ci_low"] <= x <= p["ci_high"], (p, x)
+    assert result["model"]["name"] == "planar2" and result["condition_number"] > 1.0
+
+    t2, q2, dq2, ddq2 = fourier_run(6)
+    tau2 = planar2_torques(q2, dq2, ddq2) + rng.normal(0.0, 0.05, size=q2.shape)
+    v = dynid.validate(planar2, result, t2, q2, tau2, dq=dq2, ddq=ddq2, **options)
+    assert 0.0 < v["relative_error"] < 0.05
+
+
+def test_bad_input_raises_with_a_message(planar2):
+    z = np.zeros((5, 3))
+    with pytest.raises(dynid.Error, match="q must be 5 x 2"):
+        dynid.inverse_dynamics(planar2, z, z, z)
+    with pytest.raises(TypeError, match="valid options are armature"):
+        dynid.identify(planar2, np.arange(5.0), np.zeros((5, 2)), np.zeros((5, 2)), speed=1)
+    with pytest.raises(dynid.Error, match="unknown robot|puma999"):
+        dynid.load_model("puma999")
+    nan = np.full((1, 2), np.nan)
+    with pytest.raises(dynid.Error, match="NaN"):
+        dynid.inverse_dynamics(planar2, nan, nan, nan)
