@@ -97,6 +97,18 @@ void BM_TorqueRegressor(benchmark::State& st, const std::string& name) {
   }
 }
 
+void BM_TorqueRegressorRigid(benchmark::State& st, const std::string& name) {
+  const Model& model = robot(name);
+  dynid::Workspace ws(model);
+  const State s(model.dof());
+  const auto layout = dynid::ParameterLayout::rigid();
+  Eigen::MatrixXd Y(model.dof(), layout.columns(model.dof()));
+  for (auto _ : st) {
+    dynid::torque_regressor(model, ws, layout, s.q, s.dq, s.ddq, Y);
+    benchmark::DoNotOptimize(Y.data());
+  }
+}
+
 void BM_EnergyRegressor(benchmark::State& st, const std::string& name) {
   const Model& model = robot(name);
   dynid::Workspace ws(model);
@@ -182,15 +194,16 @@ void BM_KdlRne(benchmark::State& st, const std::string& name) {
 
 }  // namespace
 
-#define DYNID_ROBOT_BENCH(robot_name)                             \
-  BENCHMARK_CAPTURE(BM_KdlRne, robot_name, #robot_name);          \
-  BENCHMARK_CAPTURE(BM_Rnea, robot_name, #robot_name);            \
-  BENCHMARK_CAPTURE(BM_RneaRigid, robot_name, #robot_name);       \
-  BENCHMARK_CAPTURE(BM_TorqueRegressor, robot_name, #robot_name); \
-  BENCHMARK_CAPTURE(BM_EnergyRegressor, robot_name, #robot_name); \
-  BENCHMARK_CAPTURE(BM_MassMatrix, robot_name, #robot_name);      \
-  BENCHMARK_CAPTURE(BM_KdlMass, robot_name, #robot_name);         \
-  BENCHMARK_CAPTURE(BM_ForwardDynamics, robot_name, #robot_name); \
+#define DYNID_ROBOT_BENCH(robot_name)                                  \
+  BENCHMARK_CAPTURE(BM_KdlRne, robot_name, #robot_name);               \
+  BENCHMARK_CAPTURE(BM_Rnea, robot_name, #robot_name);                 \
+  BENCHMARK_CAPTURE(BM_RneaRigid, robot_name, #robot_name);            \
+  BENCHMARK_CAPTURE(BM_TorqueRegressor, robot_name, #robot_name);      \
+  BENCHMARK_CAPTURE(BM_TorqueRegressorRigid, robot_name, #robot_name); \
+  BENCHMARK_CAPTURE(BM_EnergyRegressor, robot_name, #robot_name);      \
+  BENCHMARK_CAPTURE(BM_MassMatrix, robot_name, #robot_name);           \
+  BENCHMARK_CAPTURE(BM_KdlMass, robot_name, #robot_name);              \
+  BENCHMARK_CAPTURE(BM_ForwardDynamics, robot_name, #robot_name);      \
   BENCHMARK_CAPTURE(BM_KdlForwardDynamics, robot_name, #robot_name);
 
 DYNID_ROBOT_BENCH(puma560)
