@@ -1,10 +1,13 @@
-// RNEA, mass matrix, torque and energy regressors of dynid against KDL's ChainIdSolver_RNE on the
-// same robot (the KDL chain is parsed from dynid's URDF export of the built-in model).
-// Run: ./build/bench/dynamics_bench --benchmark_repetitions=5
+// RNEA, mass matrix, forward dynamics, torque and energy regressors of dynid against KDL's
+// ChainIdSolver_RNE, ChainDynParam::JntToMass and ChainFdSolver_RNE on the same robot (the KDL
+// chain is parsed from dynid's URDF export of the built-in model). Run:
+// ./build/bench/dynamics_bench --benchmark_repetitions=5
 // --benchmark_report_aggregates_only=true
 #include <random>
 
 #include <benchmark/benchmark.h>
+#include <kdl/chaindynparam.hpp>
+#include <kdl/chainfdsolver_recursive_newton_euler.hpp>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
 #include <kdl/tree.hpp>
 #include <kdl_parser/kdl_parser.hpp>
@@ -71,11 +74,34 @@ void BM_MassMatrix(benchmark::State& st, const std::string& name) {
   }
 }
 
+void BM_ForwardDynamics(benchmark::State& st, const std::string& name) {
+  const Model& model = robot(name);
+  dynid::Workspace ws(model);
+  const State s(model.dof());
+  Eigen::VectorXd ddq(model.dof());
+  for (auto _ : st) {
+    dynid::forward_dynamics(model, ws, s.q, s.dq, s.ddq, ddq);  // s.ddq serves as the torque
+    benchmark::DoNotOptimize(ddq.data());
+  }
+}
+
 void BM_TorqueRegressor(benchmark::State& st, const std::string& name) {
   const Model& model = robot(name);
   dynid::Workspace ws(model);
   const State s(model.dof());
   const auto layout = dynid::ParameterLayout::full();
+  Eigen::MatrixXd Y(model.dof(), layout.columns(model.dof()));
+  for (auto _ : st) {
+    dynid::torque_regressor(model, ws, layout, s.q, s.dq, s.ddq, Y);
+    benchmark::DoNotOptimize(Y.data());
+  }
+}
+
+void BM_TorqueRegressorRigid(benchmark::State& st, const std::string& name) {
+  const Model& model = robot(name);
+  dynid::Workspace ws(model);
+  const State s(model.dof());
+  const auto layout = dynid::ParameterLayout::rigid();
   Eigen::MatrixXd Y(model.dof(), layout.columns(model.dof()));
   for (auto _ : st) {
     dynid::torque_regressor(model, ws, layout, s.q, s.dq, s.ddq, Y);
@@ -95,15 +121,62 @@ void BM_EnergyRegressor(benchmark::State& st, const std::string& name) {
   }
 }
 
-void BM_KdlRne(benchmark::State& st, const std::string& name) {
-  Model model = robot(name);
+// The KDL chain of a built-in robot, parsed from dynid's URDF export (false if parsing failed).
+bool kdl_chain(const Model& model, KDL::Chain& chain) {
   KDL::Tree tree;
-  if (!kdl_parser::treeFromString(dynid::to_urdf(model), tree)) {
+  if (!kdl_parser::treeFromString(dynid::to_urdf(model), tree)) return false;
+  return tree.getChain("base_link", model.joints.back().link_name, chain);
+}
+
+void BM_KdlMass(benchmark::State& st, const std::string& name) {
+  const Model& model = robot(name);
+  KDL::Chain chain;
+  if (!kdl_chain(model, chain)) {
     st.SkipWithError("kdl_parser failed");
     return;
   }
+  KDL::ChainDynParam solver(chain,
+                            KDL::Vector(model.gravity.x(), model.gravity.y(), model.gravity.z()));
+  const int n = model.dof();
+  const State s(n);
+  KDL::JntArray q(n);
+  q.data = s.q;
+  KDL::JntSpaceInertiaMatrix H(n);
+  for (auto _ : st) {
+    solver.JntToMass(q, H);
+    benchmark::DoNotOptimize(H.data.data());
+  }
+}
+
+void BM_KdlForwardDynamics(benchmark::State& st, const std::string& name) {
+  const Model& model = robot(name);
   KDL::Chain chain;
-  tree.getChain("base_link", model.joints.back().link_name, chain);
+  if (!kdl_chain(model, chain)) {
+    st.SkipWithError("kdl_parser failed");
+    return;
+  }
+  KDL::ChainFdSolver_RNE solver(
+      chain, KDL::Vector(model.gravity.x(), model.gravity.y(), model.gravity.z()));
+  const int n = model.dof();
+  const State s(n);
+  KDL::JntArray q(n), dq(n), tau(n), ddq(n);
+  q.data = s.q;
+  dq.data = s.dq;
+  tau.data = s.ddq;
+  KDL::Wrenches f_ext(chain.getNrOfSegments(), KDL::Wrench::Zero());
+  for (auto _ : st) {
+    solver.CartToJnt(q, dq, tau, f_ext, ddq);
+    benchmark::DoNotOptimize(ddq.data.data());
+  }
+}
+
+void BM_KdlRne(benchmark::State& st, const std::string& name) {
+  const Model& model = robot(name);
+  KDL::Chain chain;
+  if (!kdl_chain(model, chain)) {
+    st.SkipWithError("kdl_parser failed");
+    return;
+  }
   KDL::ChainIdSolver_RNE solver(
       chain, KDL::Vector(model.gravity.x(), model.gravity.y(), model.gravity.z()));
   const int n = model.dof();
@@ -121,13 +194,17 @@ void BM_KdlRne(benchmark::State& st, const std::string& name) {
 
 }  // namespace
 
-#define DYNID_ROBOT_BENCH(robot_name)                             \
-  BENCHMARK_CAPTURE(BM_KdlRne, robot_name, #robot_name);          \
-  BENCHMARK_CAPTURE(BM_Rnea, robot_name, #robot_name);            \
-  BENCHMARK_CAPTURE(BM_RneaRigid, robot_name, #robot_name);       \
-  BENCHMARK_CAPTURE(BM_TorqueRegressor, robot_name, #robot_name); \
-  BENCHMARK_CAPTURE(BM_EnergyRegressor, robot_name, #robot_name); \
-  BENCHMARK_CAPTURE(BM_MassMatrix, robot_name, #robot_name);
+#define DYNID_ROBOT_BENCH(robot_name)                                  \
+  BENCHMARK_CAPTURE(BM_KdlRne, robot_name, #robot_name);               \
+  BENCHMARK_CAPTURE(BM_Rnea, robot_name, #robot_name);                 \
+  BENCHMARK_CAPTURE(BM_RneaRigid, robot_name, #robot_name);            \
+  BENCHMARK_CAPTURE(BM_TorqueRegressor, robot_name, #robot_name);      \
+  BENCHMARK_CAPTURE(BM_TorqueRegressorRigid, robot_name, #robot_name); \
+  BENCHMARK_CAPTURE(BM_EnergyRegressor, robot_name, #robot_name);      \
+  BENCHMARK_CAPTURE(BM_MassMatrix, robot_name, #robot_name);           \
+  BENCHMARK_CAPTURE(BM_KdlMass, robot_name, #robot_name);              \
+  BENCHMARK_CAPTURE(BM_ForwardDynamics, robot_name, #robot_name);      \
+  BENCHMARK_CAPTURE(BM_KdlForwardDynamics, robot_name, #robot_name);
 
 DYNID_ROBOT_BENCH(puma560)
 DYNID_ROBOT_BENCH(iiwa14)

@@ -1,46 +1,14 @@
 #include "dynid/dynamics/kinematics.hpp"
 
-#include <Eigen/Geometry>
+#include "dynamics/joint_pose.hpp"
 
 namespace dynid {
 
 namespace {
 
-// Pose of frame j in its parent at joint value qj: (R_PJ, p_PJ)·motion(axis, qj).
-void joint_pose(const Joint& joint, double qj, LinkState& s) {
-  if (joint.type == JointType::kRevolute) {
-    s.R_PJ.noalias() = joint.R_PJ * Eigen::AngleAxisd(qj, joint.axis).toRotationMatrix();
-    s.p_PJ = joint.p_PJ;
-  } else {
-    s.R_PJ = joint.R_PJ;
-    s.p_PJ.noalias() = joint.p_PJ + joint.R_PJ * (joint.axis * qj);
-  }
-}
-
-}  // namespace
-
-void forward_kinematics(const Model& model, Workspace& ws,
-                        const Eigen::Ref<const Eigen::VectorXd>& q) {
-  for (int j = 0; j < model.dof(); ++j) {
-    LinkState& s = ws.links[j];
-    joint_pose(model.joints[j], q[j], s);
-    const int p = model.joints[j].parent;
-    if (p < 0) {
-      s.R_WJ = s.R_PJ;
-      s.p_WJ = s.p_PJ;
-    } else {
-      const LinkState& sp = ws.links[p];
-      s.R_WJ.noalias() = sp.R_WJ * s.R_PJ;
-      s.p_WJ.noalias() = sp.p_WJ + sp.R_WJ * s.p_PJ;
-    }
-  }
-}
-
-void forward_kinematics(const Model& model, Workspace& ws,
-                        const Eigen::Ref<const Eigen::VectorXd>& q,
-                        const Eigen::Ref<const Eigen::VectorXd>& dq,
-                        const Eigen::Ref<const Eigen::VectorXd>& ddq, bool with_gravity) {
-  forward_kinematics(model, ws, q);
+// Velocities and accelerations of every link from the local poses already in ws.links.
+void motion(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& dq,
+            const Eigen::Ref<const Eigen::VectorXd>& ddq, bool with_gravity) {
   const Eigen::Vector3d a0 =
       with_gravity ? Eigen::Vector3d(-model.gravity) : Eigen::Vector3d::Zero();
   for (int j = 0; j < model.dof(); ++j) {
@@ -74,6 +42,41 @@ void forward_kinematics(const Model& model, Workspace& ws,
       s.a = a_in + 2.0 * w_in.cross(z_dq) + z_ddq;
     }
   }
+}
+
+}  // namespace
+
+void forward_kinematics(const Model& model, Workspace& ws,
+                        const Eigen::Ref<const Eigen::VectorXd>& q) {
+  for (int j = 0; j < model.dof(); ++j) {
+    LinkState& s = ws.links[j];
+    detail::joint_pose(model.joints[j], q[j], s);
+    const int p = model.joints[j].parent;
+    if (p < 0) {
+      s.R_WJ = s.R_PJ;
+      s.p_WJ = s.p_PJ;
+    } else {
+      const LinkState& sp = ws.links[p];
+      s.R_WJ.noalias() = sp.R_WJ * s.R_PJ;
+      s.p_WJ.noalias() = sp.p_WJ + sp.R_WJ * s.p_PJ;
+    }
+  }
+}
+
+void forward_kinematics(const Model& model, Workspace& ws,
+                        const Eigen::Ref<const Eigen::VectorXd>& q,
+                        const Eigen::Ref<const Eigen::VectorXd>& dq,
+                        const Eigen::Ref<const Eigen::VectorXd>& ddq, bool with_gravity) {
+  forward_kinematics(model, ws, q);
+  motion(model, ws, dq, ddq, with_gravity);
+}
+
+void detail::local_kinematics(const Model& model, Workspace& ws,
+                              const Eigen::Ref<const Eigen::VectorXd>& q,
+                              const Eigen::Ref<const Eigen::VectorXd>& dq,
+                              const Eigen::Ref<const Eigen::VectorXd>& ddq, bool with_gravity) {
+  for (int j = 0; j < model.dof(); ++j) detail::joint_pose(model.joints[j], q[j], ws.links[j]);
+  motion(model, ws, dq, ddq, with_gravity);
 }
 
 }  // namespace dynid

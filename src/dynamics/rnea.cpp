@@ -2,8 +2,8 @@
 
 #include <cassert>
 
+#include "dynamics/joint_pose.hpp"
 #include "dynamics/joint_terms.hpp"
-#include "dynid/dynamics/kinematics.hpp"
 
 namespace dynid {
 
@@ -12,7 +12,7 @@ void rnea(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::Vecto
           Eigen::Ref<Eigen::VectorXd> tau, const RneaOptions& options) {
   const int n = model.dof();
   assert(q.size() == n && dq.size() == n && ddq.size() == n && tau.size() == n);
-  forward_kinematics(model, ws, q, dq, ddq, options.gravity);
+  detail::local_kinematics(model, ws, q, dq, ddq, options.gravity);
   for (int j = 0; j < n; ++j) {
     // Newton–Euler equations of link j about its origin (Khalil–Dombre eq. 9.88–9.89).
     LinkState& s = ws.links[j];

@@ -9,6 +9,7 @@
 #include "dynid/common/error.hpp"
 #include "dynid/estimation/statistics.hpp"
 #include "factor_solve.hpp"
+#include "ud_update.hpp"
 
 namespace dynid {
 
@@ -62,26 +63,8 @@ void RecursiveLeastSquares::update(const Eigen::Ref<const Eigen::VectorXd>& d, d
                 " contains NaN or Inf in W or y; remove or repair that sample");
   }
   const double lambda = options_.forgetting_factor;
-  // Bierman's U-D update (Agee–Turner rank-one update of P = UDUᵀ) with measurement variance λ:
-  // f = Uᵀd, v = D f, α_j = λ + Σ_{i≤j} v_i f_i; afterwards UD'Uᵀ = P − P d dᵀP/(λ + dᵀPd).
-  f_.noalias() = u_.triangularView<Eigen::UnitUpper>().transpose() * d;
-  v_ = d_.cwiseProduct(f_);
-  double alpha = lambda + v_(0) * f_(0);
-  d_(0) *= lambda / alpha;
-  k_.setZero();
-  k_(0) = v_(0);
-  for (Eigen::Index j = 1; j < p; ++j) {
-    const double beta = alpha;
-    alpha += v_(j) * f_(j);
-    const double pj = -f_(j) / beta;
-    d_(j) *= beta / alpha;
-    for (Eigen::Index i = 0; i < j; ++i) {
-      const double uij = u_(i, j);
-      u_(i, j) = uij + k_(i) * pj;
-      k_(i) += uij * v_(j);
-    }
-    k_(j) = v_(j);
-  }
+  // Bierman's U-D update with measurement variance λ: afterwards UDUᵀ = P − P d dᵀP/(λ + dᵀPd).
+  const double alpha = estimation_detail::ud_update(u_, d_, d, lambda, f_, v_, k_);
   // Seed 1 eq. 36: x ← x + K·(y − dᵀx), K = P d/(λ + dᵀPd) = k/α.
   const double innovation = y - d.dot(x_);
   x_ += (innovation / alpha) * k_;

@@ -2,7 +2,7 @@
 
 #include <cassert>
 
-#include "dynid/dynamics/kinematics.hpp"
+#include "dynamics/joint_pose.hpp"
 #include "regressor/joint_columns.hpp"
 #include "regressor/wrench_kernel.hpp"
 
@@ -14,7 +14,7 @@ void torque_regressor(const Model& model, Workspace& ws, const ParameterLayout& 
                       const Eigen::Ref<const Eigen::VectorXd>& ddq, Eigen::Ref<Eigen::MatrixXd> Y) {
   const int n = model.dof();
   assert(Y.rows() == n && Y.cols() == layout.columns(n));
-  forward_kinematics(model, ws, q, dq, ddq, true);
+  detail::local_kinematics(model, ws, q, dq, ddq, true);
   Y.setZero();
   detail::WrenchBlocks b;
   for (int j = 0; j < n; ++j) {

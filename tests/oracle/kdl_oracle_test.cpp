@@ -3,11 +3,14 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include <kdl/chaindynparam.hpp>
+#include <kdl/chainfdsolver_recursive_newton_euler.hpp>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
 #include <kdl/tree.hpp>
 #include <kdl/treeidsolver_recursive_newton_euler.hpp>
 #include <kdl_parser/kdl_parser.hpp>
 
+#include "dynid/dynamics/mass_matrix.hpp"
 #include "dynid/dynamics/rnea.hpp"
 #include "dynid/io/urdf_writer.hpp"
 #include "dynid/model/robots.hpp"
@@ -87,6 +90,57 @@ TEST(KdlChainOracle, RneaMatchesChainIdSolver) {
   KDL::Chain chain;
   ASSERT_TRUE(tree.getChain("base_link", model.joints.back().link_name, chain));
   expect_chain_matches(model, chain, 77);
+}
+
+// Mass matrix against ChainDynParam::JntToMass and forward dynamics against ChainFdSolver_RNE
+// (KDL's CRBA + RNE + dense solve) on a random chain with prismatic joints and on iiwa14.
+void expect_mass_and_forward_dynamics_match(const Model& model, const KDL::Chain& chain,
+                                            unsigned seed) {
+  const int n = model.dof();
+  ASSERT_EQ(chain.getNrOfJoints(), static_cast<unsigned>(n));
+  const KDL::Vector g(model.gravity.x(), model.gravity.y(), model.gravity.z());
+  KDL::ChainDynParam dyn(chain, g);
+  KDL::ChainFdSolver_RNE fd(chain, g);
+  Workspace ws(model);
+  std::mt19937 rng(seed);
+  for (int k = 0; k < 20; ++k) {
+    const Eigen::VectorXd q = random_vector(n, rng, 3.0), dq = random_vector(n, rng, 2.0),
+                          tau = random_vector(n, rng, 20.0);
+    KDL::JntArray kq(n), kdq(n), ktau(n), kddq(n);
+    kq.data = q;
+    kdq.data = dq;
+    ktau.data = tau;
+    KDL::JntSpaceInertiaMatrix H(n);
+    ASSERT_GE(dyn.JntToMass(kq, H), 0);
+    Eigen::MatrixXd M(n, n);
+    mass_matrix(model, ws, q, M);
+    EXPECT_LT((M - H.data).norm() / H.data.norm(), testing::kOracleTolerance) << "state " << k;
+    KDL::Wrenches f_ext(chain.getNrOfSegments(), KDL::Wrench::Zero());
+    ASSERT_GE(fd.CartToJnt(kq, kdq, ktau, f_ext, kddq), 0);
+    Eigen::VectorXd ddq(n);
+    forward_dynamics(model, ws, q, dq, tau, ddq, RneaOptions{true, false});
+    // Both sides solve with M, so the comparison carries cond(M) (≈ 1e3–1e4 here).
+    EXPECT_LT((ddq - kddq.data).norm() / kddq.data.norm(), 1e3 * testing::kOracleTolerance)
+        << "state " << k;
+  }
+}
+
+TEST(KdlChainOracle, MassMatrixAndForwardDynamicsMatchChainDynParamAndFdSolver) {
+  Model model = random_tree(7, 78, true, true);
+  for (auto& j : model.joints) j.friction = {};
+  KDL::Tree tree;
+  ASSERT_TRUE(kdl_parser::treeFromString(to_urdf(model), tree));
+  KDL::Chain chain;
+  ASSERT_TRUE(tree.getChain("base_link", model.joints.back().link_name, chain));
+  expect_mass_and_forward_dynamics_match(model, chain, 78);
+  Model iiwa = load_robot("iiwa14");
+  for (auto& j : iiwa.joints) j.friction = {};  // KDL has no armature
+  KDL::Tree iiwa_tree;
+  ASSERT_TRUE(kdl_parser::treeFromFile(builtin_robots_dir() + "/iiwa14.urdf", iiwa_tree));
+  KDL::Chain iiwa_chain;
+  ASSERT_TRUE(iiwa_tree.getChain(iiwa_tree.getRootSegment()->first, iiwa.joints.back().link_name,
+                                 iiwa_chain));
+  expect_mass_and_forward_dynamics_match(iiwa, iiwa_chain, 14);
 }
 
 // The iiwa14 URDF file itself (Drake's parameters) read by kdl_parser and by dynid's loader.

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
+#include "dynid/dynamics/mass_matrix.hpp"
 #include "dynid/dynamics/rnea.hpp"
 #include "dynid/io/urdf_writer.hpp"
 #include "oracle/oracle_support.hpp"
@@ -116,6 +117,15 @@ TEST_P(MujocoOracle, RneaMatchesMjInverse) {
     rnea(compiled, ws, q, dq, ddq, tau);
     for (int j = 0; j < 8; ++j) tau_mj[j] = mj.d->qfrc_inverse[dof[j]];
     EXPECT_LT((tau - tau_mj).norm() / tau_mj.norm(), testing::kOracleTolerance) << "state " << k;
+    // Mass matrix (armature included) against MuJoCo's composite-rigid-body qM, made dense.
+    std::vector<mjtNum> dense(8 * 8);
+    mj_fullM(mj.m, dense.data(), mj.d->qM);
+    Eigen::MatrixXd M(8, 8), M_mj(8, 8);
+    mass_matrix(compiled, ws, q, M);
+    for (int i = 0; i < 8; ++i) {
+      for (int j = 0; j < 8; ++j) M_mj(i, j) = dense[8 * dof[i] + dof[j]];
+    }
+    EXPECT_LT((M - M_mj).norm() / M_mj.norm(), testing::kOracleTolerance) << "state " << k;
   }
 }
 

@@ -24,6 +24,15 @@ struct LinkState {
   Eigen::Vector3d n;     ///< moment about origin j that parent(j) exerts on link j [N·m]
 };
 
+/// Spatial inertia of a body (or a composite of bodies) about a frame's origin, in that frame: the
+/// rotational inertia about the origin, the first moment m·c and the mass. The 6×6 matrix
+/// [[I, [h×]], [−[h×], m·1]] it stands for is never formed.
+struct BodyInertia {
+  Eigen::Matrix3d I;  ///< rotational inertia about the origin [kg·m²]
+  Eigen::Vector3d h;  ///< first moment m·c [kg·m]
+  double m = 0.0;     ///< mass [kg]
+};
+
 /// Reusable scratch memory for one model and one thread. Construct once, pass to every call: the
 /// algorithms then never allocate.
 struct Workspace {
@@ -32,11 +41,10 @@ struct Workspace {
   std::vector<std::vector<int>> ancestors;  ///< ancestors[j]: j, parent(j), …, up to the root joint
   /// twists[j][k]: unit twist (ω; v at origin j) of joint ancestors[j][k], expressed in frame j.
   std::vector<std::vector<Eigen::Matrix<double, 6, 1>>> twists;
-  std::vector<Eigen::Matrix<double, 6, 6>> composite;  ///< composite spatial inertias (CRBA)
-  Eigen::MatrixXd scratch_nn;                          ///< n×n scratch (mass matrix)
-  Eigen::VectorXd scratch_n;                           ///< n scratch
-  Eigen::VectorXd scratch_n2;                          ///< n scratch
-  Eigen::LLT<Eigen::MatrixXd> llt;                     ///< factorisation reused by forward dynamics
+  std::vector<BodyInertia> composite;  ///< composite inertias of the subtrees (CRBA)
+  Eigen::MatrixXd scratch_nn;          ///< n×n scratch (mass matrix, its LᵀDL factor)
+  Eigen::VectorXd scratch_n;           ///< n scratch
+  Eigen::VectorXd scratch_n2;          ///< n scratch
 };
 
 }  // namespace dynid
