@@ -493,7 +493,9 @@ RepeatedEstimate identify_repeated(const Model& model, const std::vector<JointRe
     pieces = runs;
     piece_references = references;
   } else {
-    if (references.size() != runs.size())
+    const bool missing = std::any_of(references.begin(), references.end(),
+                                     [](const ReferenceRecord& r) { return r.qr.size() == 0; });
+    if (references.size() != runs.size() || missing)
       throw Error(
           "--repeat periods finds the period from the reference: the run needs its "
           "qr1..qrn columns");

@@ -70,8 +70,8 @@ TEST(ClosedLoopCli, ProjectionSpectralAndRepeatWriteTheirJson) {
   EXPECT_EQ(j["repeated"]["n"], 4);
   ASSERT_EQ(j["repeated"]["parameters"].size(), j["parameters"].size());
   const auto& first = j["repeated"]["parameters"][0];
-  // Table 3's column: t_0.9995(3)/sqrt(3) = 12.92/1.732 = 7.46 times the std.
-  EXPECT_NEAR(first["ci_half_width"].get<double>() / first["std"].get<double>(), 7.4597, 1e-3);
+  // Table 3's column: t_0.9995(3)/sqrt(3) = 12.924/1.7321 = 7.4617 times the std.
+  EXPECT_NEAR(first["ci_half_width"].get<double>() / first["std"].get<double>(), 7.4617, 1e-3);
 
   r = run("identify --robot planar2 --data " + data + " --closed-loop spectral --out " +
           path("spectral.json"));
