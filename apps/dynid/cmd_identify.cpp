@@ -451,8 +451,10 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
         "--stream reads named columns as they are; --torque-scale, --rows, --time and "
         "--columns by position need the in-memory mode (drop --stream)");
   }
-  if (options.estimator != IdentificationEstimator::kMl && (!o.noise.empty() || !o.noise_std.empty()))
-    throw UsageError("--noise and --noise-std are the noise of --estimator ml; add it or drop them");
+  if (options.estimator != IdentificationEstimator::kMl &&
+      (!o.noise.empty() || !o.noise_std.empty()))
+    throw UsageError(
+        "--noise and --noise-std are the noise of --estimator ml; add it or drop them");
   if (options.estimator == IdentificationEstimator::kMl && (o.stream || experiment))
     throw UsageError("--estimator ml needs the differential model in memory; drop --stream");
   if (!o.noise.empty() && !o.noise_std.empty())
@@ -462,8 +464,9 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     throw UsageError("--repeat must be periods or runs, not '" + o.repeat + "'");
   const bool closed = options.closed_loop.method != ClosedLoopMethod::kNone;
   if ((closed || !o.repeat.empty()) && (o.stream || experiment || o.model != "differential"))
-    throw UsageError("--closed-loop and --repeat work on the differential model in memory; drop "
-                     "--stream and --model");
+    throw UsageError(
+        "--closed-loop and --repeat work on the differential model in memory; drop "
+        "--stream and --model");
   warn_identify_no_effect(o, cmd);
   if (experiment) {
     run_experiment(o, options, file);
@@ -486,8 +489,8 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
       for (size_t i = 0; i < o.runs.size(); ++i)
         references.push_back(read_reference_columns(o.runs[i], model, file, records[i]));
     }
-    result = identify(model, records, closed ? references : std::vector<ReferenceRecord>{},
-                      options);
+    result =
+        identify(model, records, closed ? references : std::vector<ReferenceRecord>{}, options);
     if (!o.repeat.empty()) {
       repeated = identify_repeated(model, records, references, options,
                                    o.repeat == "runs" ? RepeatOver::kRuns : RepeatOver::kPeriods);

@@ -7,9 +7,9 @@
 #include <Eigen/SVD>
 
 #include "dynid/common/error.hpp"
+#include "dynid/estimation/closed_loop.hpp"
 #include "dynid/estimation/cutoff_selection.hpp"
 #include "dynid/estimation/integral_equations.hpp"
-#include "dynid/estimation/closed_loop.hpp"
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/maximum_likelihood.hpp"
 #include "dynid/estimation/outliers.hpp"
