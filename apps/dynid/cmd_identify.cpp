@@ -16,6 +16,7 @@
 #include "dynid/estimation/friction_experiment.hpp"
 #include "dynid/estimation/gravity_experiment.hpp"
 #include "dynid/estimation/physical_parameters.hpp"
+#include "dynid/io/closed_loop_file.hpp"
 #include "dynid/io/joint_record_file.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/io/streaming_identification.hpp"
@@ -57,6 +58,10 @@ struct IdentifyCliOptions {
   bool physical = false;               // --physical
 
   std::vector<std::string> friction_known;  // --friction-known, repeatable
+  std::string closed_loop = "none";         // --closed-loop
+  std::string fir;                          // --fir M1,M2
+  std::string noise, noise_std;             // --noise FILE, --noise-std q=S,tau=S (ml)
+  std::string repeat;                       // --repeat periods|runs
 };
 
 // The run named by `flag` must be a readable file (so the error names the flag the user gave).
@@ -174,7 +179,8 @@ IdentificationEstimator parse_estimator(const std::string& text) {
   if (text == "ols") return IdentificationEstimator::kOls;
   if (text == "wls") return IdentificationEstimator::kWls;
   if (text == "rls") return IdentificationEstimator::kRls;
-  throw UsageError("--estimator must be ols, wls or rls, not '" + text + "'");
+  if (text == "ml") return IdentificationEstimator::kMl;
+  throw UsageError("--estimator must be ols, wls, rls or ml, not '" + text + "'");
 }
 
 IdentifyOptions library_options(const IdentifyCliOptions& o) {
@@ -197,6 +203,31 @@ IdentifyOptions library_options(const IdentifyCliOptions& o) {
     throw UsageError("--outliers must be report or drop, not '" + o.outliers + "'");
   }
   out.outliers.policy = o.outliers == "drop" ? OutlierPolicy::kDrop : OutlierPolicy::kReport;
+  if (o.closed_loop == "projection") {
+    out.closed_loop.method = ClosedLoopMethod::kProjection;
+  } else if (o.closed_loop == "spectral") {
+    out.closed_loop.method = ClosedLoopMethod::kSpectral;
+  } else if (o.closed_loop != "none") {
+    throw UsageError("--closed-loop must be none, projection or spectral, not '" + o.closed_loop +
+                     "'");
+  }
+  if (!o.fir.empty()) {
+    if (o.closed_loop != "projection")
+      throw UsageError("--fir sets the projection's FIR orders: it needs --closed-loop projection");
+    const auto parts = split(o.fir, ',');
+    try {
+      size_t a = 0, b = 0;
+      if (parts.size() != 2) throw UsageError("");
+      out.closed_loop.projection.m1 = std::stoi(parts[0], &a);
+      out.closed_loop.projection.m2 = std::stoi(parts[1], &b);
+      if (a != parts[0].size() || b != parts[1].size() || out.closed_loop.projection.m1 < 0 ||
+          out.closed_loop.projection.m2 < 0)
+        throw UsageError("");
+    } catch (const std::exception&) {
+      throw UsageError("--fir '" + o.fir +
+                       "' is not M1,M2 (two integers >= 0: future and past reference lags)");
+    }
+  }
   if (o.model == "integral") {
     out.model = IdentificationModel::kIntegral;
     if (!(o.interval >= 0.0)) {
@@ -231,7 +262,12 @@ nlohmann::json echo(const IdentifyCliOptions& o) {
           {"torque_scale", o.torque_scale},
           {"rows", o.rows},
           {"time", o.time},
-          {"friction_known", o.friction_known}};
+          {"friction_known", o.friction_known},
+          {"closed_loop", o.closed_loop},
+          {"fir", o.fir},
+          {"noise", o.noise},
+          {"noise_std", o.noise_std},
+          {"repeat", o.repeat}};
 }
 
 // The flags that say how to read a run (identify, validate).
@@ -446,6 +482,22 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
         "--stream reads named columns as they are; --torque-scale, --rows, --time and "
         "--columns by position need the in-memory mode (drop --stream)");
   }
+  if (options.estimator != IdentificationEstimator::kMl &&
+      (!o.noise.empty() || !o.noise_std.empty()))
+    throw UsageError(
+        "--noise and --noise-std are the noise of --estimator ml; add it or drop them");
+  if (options.estimator == IdentificationEstimator::kMl && (o.stream || experiment))
+    throw UsageError("--estimator ml needs the differential model in memory; drop --stream");
+  if (!o.noise.empty() && !o.noise_std.empty())
+    throw UsageError("give --noise FILE or --noise-std q=S,tau=S, not both");
+  if (!o.noise.empty()) require_readable(o.noise, "--noise");
+  if (!o.repeat.empty() && o.repeat != "periods" && o.repeat != "runs")
+    throw UsageError("--repeat must be periods or runs, not '" + o.repeat + "'");
+  const bool closed = options.closed_loop.method != ClosedLoopMethod::kNone;
+  if ((closed || !o.repeat.empty()) && (o.stream || experiment || o.model != "differential"))
+    throw UsageError(
+        "--closed-loop and --repeat work on the differential model in memory; drop "
+        "--stream and --model");
   warn_identify_no_effect(o, cmd);
   if (experiment) {
     run_experiment(o, options, file);
@@ -454,6 +506,7 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   const Model model = load_robot(o.robot);
   RunFileReport read;
   IdentificationResult result;
+  RepeatedEstimate repeated;
   std::vector<JointRecord> records;
   if (o.stream) {
     result = identify_stream(model, o.data, file, options, {o.threads, true});
@@ -468,7 +521,19 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
       }
       add_known_friction(options.known_friction, model, known.names, known.values, f);
     }
-    result = identify(model, records, options);
+    if (!o.noise.empty()) options.noise = read_sensor_noise(o.noise, model);
+    if (!o.noise_std.empty()) options.noise = parse_noise_std(o.noise_std, model.dof());
+    std::vector<ReferenceRecord> references;
+    if (closed || o.repeat == "periods") {
+      for (size_t i = 0; i < o.runs.size(); ++i)
+        references.push_back(read_reference_columns(o.runs[i], model, file, records[i]));
+    }
+    result =
+        identify(model, records, closed ? references : std::vector<ReferenceRecord>{}, options);
+    if (!o.repeat.empty()) {
+      repeated = identify_repeated(model, records, references, options,
+                                   o.repeat == "runs" ? RepeatOver::kRuns : RepeatOver::kPeriods);
+    }
     for (size_t i = 0; i < result.runs.size(); ++i) result.runs[i].file = o.runs[i];
   }
   echo_choices("identify", read, result.choices);
@@ -480,6 +545,12 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   if (o.runs.size() > 1) used["data_runs"] = o.runs;
   if (!o.history.empty()) used["history"] = o.history;
   nlohmann::json out = identification_to_json(model, result, used);
+  if (closed) out["closed_loop"] = closed_loop_to_json(result.closed_loop);
+  if (!o.repeat.empty()) {
+    out["repeated"] = repeated_to_json(repeated, o.repeat);
+    std::cout << "repeated over " << repeated.n << " " << o.repeat
+              << ": mean, std and t/sqrt(n-1)*std per parameter in " << o.out << '\n';
+  }
   if (o.physical) {
     if (!result.not_excited.empty()) {
       throw Error(
@@ -753,8 +824,29 @@ void add_identify_command(CLI::App& app) {
   cmd->add_flag("--physical", o->physical,
                 "Also fit physically consistent standard parameters (mass > 0, realisable "
                 "inertia, friction >= 0; log-Cholesky, Rucker and Wensing 2022) to the estimate");
-  cmd->add_option("--estimator", o->estimator, "ols, wls (Gautier two-step) or rls (U-D recursive)")
+  cmd->add_option("--estimator", o->estimator,
+                  "ols, wls (Gautier two-step), rls (U-D recursive) or ml (maximum likelihood with "
+                  "noisy q and tau: B. Bona, A. Curatella, Closed-loop rigid model "
+                  "identification of an industrial robot, 2005)")
       ->capture_default_str();
+  cmd->add_option("--closed-loop", o->closed_loop,
+                  "none (filter the measured signals), projection (project q and tau, and the "
+                  "regressor alike, on the lagged references qr*: Forssell and Ljung, A "
+                  "projection method for closed-loop identification, 2000) or spectral (keep a "
+                  "periodic reference's lines, derivatives analytic); both need qr1..qrn columns")
+      ->capture_default_str();
+  cmd->add_option("--fir", o->fir,
+                  "With --closed-loop projection: FIR orders M1,M2 (future, past reference "
+                  "lags); default: the smallest passing a remainder-reference correlation test");
+  cmd->add_option("--noise", o->noise,
+                  "With --estimator ml: noise JSON of dynid average --json (std of q<j>, tau<j>)");
+  cmd->add_option("--noise-std", o->noise_std,
+                  "With --estimator ml: raw sensor noise q=S,tau=S [rad, N m] for every joint; "
+                  "default: estimated from the data (white floor of each spectrum)");
+  cmd->add_option("--repeat", o->repeat,
+                  "periods or runs: also identify each whole period (or each --data run) alone "
+                  "and report mean, std and t/sqrt(n-1)*std per parameter (Bona and Curatella "
+                  "2005, Table 3)");
   cmd->add_option("--confidence", o->confidence, "Confidence level of the intervals")
       ->capture_default_str();
   cmd->add_option("--zero-velocity", o->zero_velocity,

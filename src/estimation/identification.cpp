@@ -8,9 +8,11 @@
 #include <Eigen/SVD>
 
 #include "dynid/common/error.hpp"
+#include "dynid/estimation/closed_loop.hpp"
 #include "dynid/estimation/cutoff_selection.hpp"
 #include "dynid/estimation/integral_equations.hpp"
 #include "dynid/estimation/least_squares.hpp"
+#include "dynid/estimation/maximum_likelihood.hpp"
 #include "dynid/estimation/outliers.hpp"
 #include "dynid/estimation/pipeline.hpp"
 #include "dynid/estimation/recursive_least_squares.hpp"
@@ -441,6 +443,12 @@ IdentificationResult identify(const Model& model, const JointRecord& record,
 
 IdentificationResult identify(const Model& model, const std::vector<JointRecord>& runs,
                               const IdentifyOptions& options) {
+  return identify(model, runs, {}, options);
+}
+
+IdentificationResult identify(const Model& model, const std::vector<JointRecord>& runs,
+                              const std::vector<ReferenceRecord>& references,
+                              const IdentifyOptions& options) {
   if (runs.empty()) throw Error("identify: no run given; pass at least one recorded run");
   const int n = model.dof();
   IdentificationResult result;
@@ -448,6 +456,16 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
   const bool integral = options.model == IdentificationModel::kIntegral;
   if (integral && !options.known_friction.empty())
     throw UsageError("known friction is subtracted from joint torques: use the differential model");
+  const bool closed = options.closed_loop.method != ClosedLoopMethod::kNone;
+  const bool ml = options.estimator == IdentificationEstimator::kMl;
+  check_closed_loop_request(options, runs.size(), references.size());
+  Eigen::Index projected_dimensions = 0;  // Σ over runs and joints of the projector's rank
+  std::vector<ProcessedRecord> prepared;  // every run's (maximum likelihood needs them all)
+  if (closed && !options.known_friction.empty()) {
+    throw UsageError(
+        "known friction is subtracted before the differential model's own preparation; it is not "
+        "available with --closed-loop (leave out --friction-known or the closed-loop preparation)");
+  }
   if (integral) {
     std::ostringstream m;
     m << "integral (energy) model, "
@@ -467,7 +485,17 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
     screened.push_back(screen_run(model, runs[i], options.outliers));  // outliers.hpp
     ProcessedRecord processed;
     Eigen::VectorXd threshold = Eigen::VectorXd::Zero(n);
-    if (integral) {
+    if (closed) {
+      ClosedLoopIdOptions co = options.closed_loop;
+      co.torque_time_offset = options.signal.torque_time_offset;
+      ClosedLoopRun cl = prepare_closed_loop(screened.back().record, references[i], co, choices);
+      processed = std::move(cl.processed);
+      blocks.push_back(project_equations(
+          differential_equations(model, options.layout, coupling, processed, Eigen::VectorXd()),
+          *cl.projector));
+      projected_dimensions += static_cast<Eigen::Index>(n) * cl.report.rank;
+      result.closed_loop.push_back(std::move(cl.report));
+    } else if (integral) {
       // The held-out cut-off selection fits the differential model; the integral model has its
       // own fixed defaults (integral_signal_options()).
       SignalOptions signal = options.signal;
@@ -498,6 +526,7 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
     result.zero_velocity_threshold = result.zero_velocity_threshold.cwiseMax(threshold);
     const std::string prefix = runs.size() > 1 ? "run " + std::to_string(i + 1) + " " : "";
     for (auto& [key, value] : choices) result.choices.emplace_back(prefix + key, value);
+    if (ml) prepared.push_back(processed);
     if (i == 0) result.processed = std::move(processed);
     result.warnings.insert(result.warnings.end(), screened.back().warnings.begin(),
                            screened.back().warnings.end());
@@ -555,7 +584,7 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
   eo.hac_bandwidth = options.hac_bandwidth;
   eo.record_history = options.record_history;
   BlockEstimate fit = estimate_block(W, eo);
-  if (blocks.size() > 1 && fit.hac.bandwidth > 0) {
+  if (blocks.size() > 1 && fit.hac.bandwidth > 0 && !closed) {
     // Restack with runs a window apart and that window fixed, so that the HAC sums never pair two
     // runs' errors (the estimate itself does not depend on the spacing).
     eo.hac_bandwidth = fit.hac.bandwidth;
@@ -565,6 +594,20 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
     if (deficient) spaced = select_columns(spaced, data.kept);
     fit = estimate_block(spaced, eo);
     fit.covariance_choice += "; runs stacked a window apart (no window spans two runs)";
+  }
+  if (closed) {
+    EstimationOptions so;
+    so.confidence_level = options.confidence_level;
+    so.names = W.columns;
+    fit.covariance_choice =
+        projected_statistics(fit.estimate, W, projected_dimensions,
+                             options.estimator == IdentificationEstimator::kWls, so);
+  }
+  if (ml) {
+    std::vector<int> columns;
+    for (int c : data.kept) columns.push_back(result.base.base[static_cast<size_t>(c)]);
+    maximum_likelihood_stage(model, options, coupling, blocks, prepared, screened.front().record,
+                             columns, W, fit, result.choices);
   }
   check_finite_estimate(fit.estimate, screened.front());
   result.estimate = std::move(fit.estimate);

@@ -1,13 +1,18 @@
 #include "dynid/estimation/maximum_likelihood.hpp"
 
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 
 #include <ceres/ceres.h>
 #include <Eigen/Cholesky>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/statistics.hpp"
+#include "dynid/signal/lowpass_design.hpp"
+#include "dynid/signal/noise_floor.hpp"
 
 namespace dynid {
 
@@ -249,6 +254,122 @@ Estimate maximum_likelihood(const EquationBlock& block, const Eigen::MatrixXd& s
     summary->variance_factor = variance_factor;
   }
   return est;
+}
+
+MeasurementNoise processed_noise(const SensorNoise& given, const SignalOptions& signal,
+                                 const ProcessedRecord& processed, const JointRecord& raw,
+                                 std::string& how) {
+  const auto n = processed.record.q.cols();
+  const double rate = processed.rate_hz * processed.decimate;
+  auto check = [&](const Eigen::VectorXd& x, const char* what) {
+    if (x.size() != 0 && (x.size() != n || !x.allFinite() || (x.array() < 0.0).any()))
+      throw Error(std::string("the ") + what + " noise needs " + std::to_string(n) +
+                  " finite standard deviations >= 0, got " + std::to_string(x.size()));
+  };
+  check(given.q, "position");
+  check(given.tau, "torque");
+  Eigen::VectorXd sq = given.q, st = given.tau;
+  std::string source_q = "given", source_tau = "given";
+  if (sq.size() == 0) {
+    sq = processed.position_noise_std;
+    source_q = "estimated (white floor of q's spectrum)";
+  }
+  if (st.size() == 0) {
+    st = position_noise_floor(raw.tau, rate).noise_std;
+    source_tau = "estimated (white floor of tau's spectrum)";
+    for (Eigen::Index j = 0; j < st.size(); ++j)
+      if (!std::isfinite(st[j]) || !(st[j] > 0.0))
+        throw Error("maximum likelihood: the torque noise of joint " + std::to_string(j + 1) +
+                    " is not visible in the data (no white floor in its spectrum); give "
+                    "--noise-std tau=S or --noise FILE from dynid average");
+  }
+  sq = sq.unaryExpr([](double v) { return std::isfinite(v) ? v : 0.0; });
+  // Gains of the processing chain identify() applied (preprocess(): unit-DC-gain low-pass).
+  SosFilter filter;
+  const bool filtered = signal.filter && processed.cutoff_hz > 0.0;
+  if (filtered) {
+    LowpassOptions lp;
+    lp.family = signal.family;
+    lp.order = signal.order;
+    lp.cutoff_hz = processed.cutoff_hz;
+    lp.sample_rate_hz = rate;
+    lp.ripple_db = signal.ripple_db;
+    filter = design_lowpass(lp);
+    double dc = 1.0;
+    for (int k = 0; k < filter.sections(); ++k) {
+      const auto row = filter.sos.row(k);
+      dc *= (row(0) + row(1) + row(2)) / (row(3) + row(4) + row(5));
+    }
+    filter.sos.row(0).head<3>() /= dc;
+  }
+  const SosFilter* f = filtered ? &filter : nullptr;
+  const double g0 = white_noise_gain(f, 0, rate), g1 = white_noise_gain(f, 1, rate),
+               g2 = white_noise_gain(f, 2, rate);
+  MeasurementNoise out;
+  out.q = g0 * sq;
+  out.dq = g1 * sq;
+  out.ddq = g2 * sq;
+  out.tau = g0 * st;
+  std::ostringstream s;
+  s << std::setprecision(3) << "raw std q [" << sq.transpose() << "] " << source_q << ", tau ["
+    << st.transpose() << "] " << source_tau << "; through the "
+    << (filtered ? "filter" : "unfiltered chain") << " and central differences: q x " << g0
+    << ", dq x " << g1 << ", ddq x " << g2 << ", tau x " << g0;
+  how = s.str();
+  return out;
+}
+
+void maximum_likelihood_stage(const Model& model, const IdentifyOptions& options, bool coupling,
+                              const std::vector<EquationBlock>& blocks,
+                              const std::vector<ProcessedRecord>& processed,
+                              const JointRecord& first_raw, const std::vector<int>& columns,
+                              const EquationBlock& stacked, BlockEstimate& fit,
+                              std::vector<std::pair<std::string, std::string>>& choices) {
+  if (blocks.size() != processed.size() || blocks.empty())
+    throw Error("maximum_likelihood_stage: one processed record per block is needed");
+  const int n = model.dof();
+  std::vector<Eigen::MatrixXd> parts;
+  Eigen::Index rows = 0;
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    parts.push_back(differential_sensitivity(model, options.layout, coupling, processed[b], columns,
+                                             blocks[b].sample, blocks[b].group));
+    rows += parts.back().rows();
+  }
+  Eigen::MatrixXd sensitivity(rows, static_cast<Eigen::Index>(columns.size()));
+  Eigen::Index at = 0;
+  for (const auto& part : parts) {
+    sensitivity.middleRows(at, part.rows()) = part;
+    at += part.rows();
+  }
+  std::string how;
+  const MeasurementNoise noise =
+      processed_noise(options.noise, options.signal, processed.front(), first_raw, how);
+  choices.emplace_back("noise", how);
+  EstimationOptions eo;
+  eo.confidence_level = options.confidence_level;
+  eo.names = stacked.columns;
+  MaximumLikelihoodSummary summary;
+  fit.estimate = maximum_likelihood(stacked, sensitivity, noise, fit.estimate.x, eo, {}, &summary);
+  const Eigen::VectorXd e = stacked.y - stacked.W * fit.estimate.x;
+  fit.residual = e;
+  fit.relative_error = e.norm() / std::max(stacked.y.norm(), 1e-300);
+  Eigen::VectorXd e2 = Eigen::VectorXd::Zero(n), y2 = Eigen::VectorXd::Zero(n),
+                  cnt = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index i = 0; i < e.size(); ++i) {
+    e2[stacked.group[i]] += e[i] * e[i];
+    y2[stacked.group[i]] += stacked.y[i] * stacked.y[i];
+    cnt[stacked.group[i]] += 1.0;
+  }
+  fit.group_rms = (e2.array() / cnt.array().max(1.0)).sqrt();
+  fit.group_relative_error = (e2.array() / y2.array().max(1e-300)).sqrt();
+  std::ostringstream c;
+  c << std::setprecision(3)
+    << "maximum likelihood with errors in q, dq, ddq and tau (Bona, Curatella eqs. 15-16; Ceres "
+       "Levenberg-Marquardt from OLS, "
+    << summary.iterations << " iterations, " << summary.termination << "); variance factor "
+    << summary.variance_factor << " (about 1 when the noise is right); "
+    << fit.estimate.covariance_kind << " covariance on the whitened rows";
+  fit.covariance_choice = c.str();
 }
 
 }  // namespace dynid

@@ -287,6 +287,7 @@ BlockEstimate estimate_as_given(const EquationBlock& block, const BlockEstimatio
   eo.names = block.columns;
   switch (options.estimator) {
     case IdentificationEstimator::kOls:
+    case IdentificationEstimator::kMl:  // the start of maximum likelihood (identify())
       out.estimate = ordinary_least_squares(W, y, groups, eo);
       break;
     case IdentificationEstimator::kWls:

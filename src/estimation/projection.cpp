@@ -7,6 +7,7 @@
 #include <boost/math/distributions/normal.hpp>
 #include <cmath>
 #include <complex>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -82,23 +83,66 @@ Eigen::VectorXd apply_fir(const Eigen::MatrixXd& x, const Eigen::Ref<const Eigen
   return out;
 }
 
-// Least-squares FIR coefficients (cols × p) by the eigen-decomposition of the Jacobi-scaled Gram,
-// dropping directions the reference does not span (a few-harmonic reference spans few).
-Eigen::MatrixXd fit_fir(const Eigen::MatrixXd& r, const Eigen::MatrixXd& y, const Window& win,
-                        double tolerance) {
-  const Eigen::MatrixXd g = lagged_gram(r, win);
-  const Eigen::VectorXd d = g.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
-  const Eigen::MatrixXd gs = d.asDiagonal() * g * d.asDiagonal();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(gs);
-  const Eigen::VectorXd lambda = eig.eigenvalues();
-  const double cut = tolerance * lambda.maxCoeff();
-  Eigen::VectorXd inv = Eigen::VectorXd::Zero(lambda.size());
-  for (Eigen::Index k = 0; k < lambda.size(); ++k)
-    if (lambda[k] > cut) inv[k] = 1.0 / lambda[k];
-  const Eigen::MatrixXd rhs = d.asDiagonal() * lagged_rhs(r, y, win);
-  return d.asDiagonal() *
-         (eig.eigenvectors() * (inv.asDiagonal() * (eig.eigenvectors().transpose() * rhs)));
-}
+// Least-squares FIR coefficients by the eigen-decomposition of the Jacobi-scaled Gram, dropping
+// directions the reference does not span (a few-harmonic reference spans few); factored once, so
+// that the regressor columns can be projected with the same operator.
+struct FirSolver {
+  Eigen::VectorXd d, inv;
+  Eigen::MatrixXd v;
+  int rank = 0;
+
+  FirSolver(const Eigen::MatrixXd& r, const Window& win, double tolerance) {
+    const Eigen::MatrixXd g = lagged_gram(r, win);
+    d = g.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+    const Eigen::MatrixXd gs = d.asDiagonal() * g * d.asDiagonal();
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(gs);
+    const Eigen::VectorXd lambda = eig.eigenvalues();
+    const double cut = tolerance * lambda.maxCoeff();
+    inv = Eigen::VectorXd::Zero(lambda.size());
+    for (Eigen::Index k = 0; k < lambda.size(); ++k)
+      if (lambda[k] > cut) {
+        inv[k] = 1.0 / lambda[k];
+        ++rank;
+      }
+    v = eig.eigenvectors();
+  }
+
+  // Coefficients (cols × p) for the outputs y (m × p, rows t0 … t1 used).
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& r, const Eigen::MatrixXd& y,
+                        const Window& win) const {
+    const Eigen::MatrixXd rhs = d.asDiagonal() * lagged_rhs(r, y, win);
+    return d.asDiagonal() * (v * (inv.asDiagonal() * (v.transpose() * rhs)));
+  }
+};
+
+// P·x on the window: the least-squares fit of x on the lagged references, evaluated.
+class FirProjector : public SignalProjector {
+ public:
+  FirProjector(Eigen::MatrixXd r, const Window& win, double tolerance)
+      : r_(std::move(r)), win_(win), solver_(r_, win_, tolerance) {}
+  Eigen::MatrixXd project(const Eigen::Ref<const Eigen::MatrixXd>& x) const override {
+    if (x.rows() != win_.len)
+      throw Error("projection: " + std::to_string(x.rows()) +
+                  " samples to project, the window has " + std::to_string(win_.len));
+    Eigen::MatrixXd padded = Eigen::MatrixXd::Zero(r_.rows(), x.cols());
+    padded.middleRows(win_.t0, win_.len) = x;
+    const Eigen::MatrixXd coef = solver_.solve(r_, padded, win_);
+    Eigen::MatrixXd out(win_.len, x.cols());
+    for (Eigen::Index c = 0; c < x.cols(); ++c) out.col(c) = apply_fir(r_, coef.col(c), win_, true);
+    return out;
+  }
+  int rank() const override { return solver_.rank; }
+  Eigen::Index samples() const override { return win_.len; }
+  // FIR coefficients of the outputs y (m × p over the whole run).
+  Eigen::MatrixXd coefficients(const Eigen::MatrixXd& y) const {
+    return solver_.solve(r_, y, win_);
+  }
+
+ private:
+  Eigen::MatrixXd r_;
+  Window win_;
+  FirSolver solver_;
+};
 
 // Normalised correlations by FFT: out(τ) = Σ_t a(t)·b(t − τ) / (len·σ_a·σ_b), τ = −lags … lags,
 // of centred a, b (size len).
@@ -225,10 +269,12 @@ ProjectionResult project_on_reference(const JointRecord& run,
   };
   Eigen::MatrixXd coef;
   Window win{};
+  std::shared_ptr<FirProjector> projector;
   if (options.m1 >= 0) {
     check_orders(options.m1, options.m2, m, n);
     win = window_for(options.m1, options.m2, m);
-    coef = fit_fir(r, u, win, options.rank_tolerance);
+    projector = std::make_shared<FirProjector>(r, win, options.rank_tolerance);
+    coef = projector->coefficients(u);
     Eigen::MatrixXd rem(win.len, n);
     for (Eigen::Index j = 0; j < n; ++j)
       rem.col(j) = u.col(j).segment(win.t0, win.len) - apply_fir(r, coef.col(j), win, true);
@@ -243,19 +289,22 @@ ProjectionResult project_on_reference(const JointRecord& run,
     for (int k : orders) {
       if (m - 2 * k < 4 * (n * (2 * k + 1) + 1)) break;  // the run is too short for this order
       const Window w = window_for(k, k, m);
-      Eigen::MatrixXd c = fit_fir(r, u, w, options.rank_tolerance);
+      auto candidate = std::make_shared<FirProjector>(r, w, options.rank_tolerance);
+      Eigen::MatrixXd c = candidate->coefficients(u);
       Eigen::MatrixXd rem(w.len, n);
       for (Eigen::Index j = 0; j < n; ++j)
         rem.col(j) = u.col(j).segment(w.t0, w.len) - apply_fir(r, c.col(j), w, true);
       out.tests.push_back(remainder_test(rem, r, w, lags_for(w), options.significance));
       win = w;
       coef = std::move(c);
+      projector = std::move(candidate);
       if (out.tests.back().passed) break;
     }
   }
   out.m1 = win.m1;
   out.m2 = win.m2;
   out.fir = coef;
+  out.projector = projector;
 
   JointRecord& rec = out.processed.record;
   rec.t = run.t.segment(win.t0, win.len);

@@ -219,7 +219,7 @@ TEST(IdentifyCli, BadInputsGiveOneErrorLineAndNoOutput) {
   std::filesystem::remove(out);
   CliRun r = run("identify --robot planar2 --data " + data + " --estimator magic --out " + out);
   EXPECT_EQ(r.code, 2);
-  EXPECT_EQ(r.err, "error: --estimator must be ols, wls or rls, not 'magic'\n");
+  EXPECT_EQ(r.err, "error: --estimator must be ols, wls, rls or ml, not 'magic'\n");
   r = run("identify --robot planar2 --data /no/such.csv --out " + out);
   EXPECT_EQ(r.code, 1);
   EXPECT_EQ(r.err.rfind("error: ", 0), 0u);

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include "dynid/estimation/closed_loop_options.hpp"
 #include "dynid/estimation/estimate.hpp"
 #include "dynid/estimation/integral_options.hpp"
 #include "dynid/estimation/known_friction.hpp"
@@ -74,7 +75,8 @@ struct SignalOptions {
 /// Throws dynid::UsageError for any other count.
 Eigen::VectorXd given_zero_velocity(const std::vector<double>& zero_velocity, int n);
 
-enum class IdentificationEstimator { kOls, kWls, kRls };
+/// kMl: maximum likelihood with errors in variables (maximum_likelihood.hpp), from the OLS start.
+enum class IdentificationEstimator { kOls, kWls, kRls, kMl };
 
 /// Which equations identify() builds from each prepared run (DESIGN.md §8, "equations").
 enum class IdentificationModel {
@@ -108,6 +110,11 @@ struct IdentifyOptions {
   /// Persistent-excitation window ρ (equations) of the RLS excitation report; 0 = max(10 ×
   /// parameters, equations/10).
   int excitation_window = 0;
+  /// Closed-loop preparation (projection, spectral) instead of filtering; needs the references
+  /// (identify() with ReferenceRecord). `signal` then only gives the torque time offset.
+  ClosedLoopIdOptions closed_loop;
+  /// With the ML estimator: the raw sensor noise (empty entries estimated from the data).
+  SensorNoise noise;
 };
 
 /// One run of a (possibly several-run) identification.
@@ -184,6 +191,8 @@ struct IdentificationResult {
   /// With IdentifyOptions::record_history and RLS: per equation its time [s], the estimate and σ.
   Eigen::VectorXd history_t;
   Eigen::MatrixXd history_x, history_std;
+  /// With a closed-loop preparation: per run, what it chose and found.
+  std::vector<ClosedLoopReport> closed_loop;
 };
 
 /// Sample-major stacked regressor of the layout plus coupling columns for a record:
@@ -215,6 +224,17 @@ IdentificationResult identify(const Model& model, const JointRecord& record,
 /// Throws dynid::Error for no run and as identify().
 IdentificationResult identify(const Model& model, const std::vector<JointRecord>& runs,
                               const IdentifyOptions& options = {});
+
+/// identify() of closed-loop runs with their references (one per run, or none without
+/// options.closed_loop): each run prepared by prepare_closed_loop() (closed_loop.hpp) instead of
+/// filtering, its equations projected alike (project_equations, no zero-velocity removal), and
+/// the intervals counted on the projected dimensions (projected_statistics). With kMl (direct
+/// runs only): maximum_likelihood() from the OLS estimate, noise from options.noise or the data.
+/// Throws dynid::Error for a reference count that does not match, ML with a closed-loop
+/// preparation, and as identify().
+IdentificationResult identify(const Model& model, const std::vector<JointRecord>& runs,
+                              const std::vector<ReferenceRecord>& references,
+                              const IdentifyOptions& options);
 
 /// Per-joint prediction error of identified base parameters on another record (dynid validate).
 /// Two figures: over every row (the headline), and over the rows identify() fits (near-still rows

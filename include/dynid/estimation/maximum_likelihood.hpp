@@ -8,6 +8,7 @@
 #include "dynid/estimation/equation_block.hpp"
 #include "dynid/estimation/estimate.hpp"
 #include "dynid/estimation/identification.hpp"
+#include "dynid/estimation/pipeline.hpp"
 #include "dynid/model/model.hpp"
 #include "dynid/regressor/parameter_layout.hpp"
 
@@ -73,5 +74,28 @@ Estimate maximum_likelihood(const EquationBlock& block, const Eigen::MatrixXd& s
                             const EstimationOptions& estimation_options = {},
                             const MaximumLikelihoodOptions& options = {},
                             MaximumLikelihoodSummary* summary = nullptr);
+
+/// Noise of the processed signals (MeasurementNoise) from raw sensor noise: σ_q·g₀, σ_q·g₁,
+/// σ_q·g₂ and σ_τ·g₀, g_k = white_noise_gain() of identify()'s zero-phase filter (as preprocess()
+/// designs it from `signal` and the run's cut-off, unit DC gain) followed by k central
+/// differences at the raw rate. Raw σ from `given` where set, else estimated from `raw` (the
+/// run as logged): σ_q = processed.position_noise_std, σ_τ = the white floor of τ's spectrum
+/// (position_noise_floor applied to τ). `how` receives one line saying which. Throws
+/// dynid::Error when σ_τ is not > 0 (given as 0, or no floor visible: give it).
+MeasurementNoise processed_noise(const SensorNoise& given, const SignalOptions& signal,
+                                 const ProcessedRecord& processed, const JointRecord& raw,
+                                 std::string& how);
+
+/// The estimate stage of identify() with IdentificationEstimator::kMl: maximum_likelihood() on
+/// the stacked equations `stacked` (data-identifiable base columns `columns` of the layout) from
+/// fit's OLS estimate, with the sensitivity of every run's block (`blocks`, `processed` in run
+/// order) and processed_noise() of the first run; fit's estimate, residuals and covariance choice
+/// are replaced and the noise used is appended to `choices`. Throws as maximum_likelihood().
+void maximum_likelihood_stage(const Model& model, const IdentifyOptions& options, bool coupling,
+                              const std::vector<EquationBlock>& blocks,
+                              const std::vector<ProcessedRecord>& processed,
+                              const JointRecord& first_raw, const std::vector<int>& columns,
+                              const EquationBlock& stacked, BlockEstimate& fit,
+                              std::vector<std::pair<std::string, std::string>>& choices);
 
 }  // namespace dynid

@@ -1,24 +1,28 @@
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "dynid/estimation/closed_loop_options.hpp"
 #include "dynid/estimation/identification.hpp"
 
 namespace dynid {
 
-/// Options of project_on_reference() (stage 1 of the projection method).
-struct ProjectionOptions {
-  int m1 = -1;  ///< non-causal lags (future reference samples, seed 2 eq. 10); −1 = choose
-  int m2 =
-      -1;  ///< causal lags (past reference samples); −1 = choose (m1, m2 both given or both −1)
-  int max_order = 128;         ///< largest M1 = M2 tried when choosing
-  double significance = 0.01;  ///< family-wise level of the remainder–reference correlation test
-  int test_lags = -1;  ///< largest |lag| tested; −1 = max(100, 3·max(M1, M2)), at most m/4
-  double rank_tolerance = 1e-10;  ///< eigenvalues of the lagged-reference Gram below this × the
-                                  ///< largest are dropped (a few-harmonic reference spans few
-                                  ///< dimensions; the projection is still unique)
+/// Orthogonal projection of signals sampled on a run's window onto a fixed subspace of time
+/// series (the span of the lagged references, or the lines of a periodic excitation): the same
+/// operator P applied to the torques, positions and every regressor column, so that P·y = P·W·θ
+/// keeps the regression exact (Gautier's parallel filtering, with P for the filter).
+class SignalProjector {
+ public:
+  virtual ~SignalProjector() = default;
+  /// P·x for x (samples() × k, one signal per column, the window's samples); same size out.
+  virtual Eigen::MatrixXd project(const Eigen::Ref<const Eigen::MatrixXd>& x) const = 0;
+  /// Dimension of the subspace (per signal): the degrees of freedom one projected signal keeps.
+  virtual int rank() const = 0;
+  /// Samples of the window the projector acts on.
+  virtual Eigen::Index samples() const = 0;
 };
 
 /// The remainder–reference correlation test of one FIR order.
@@ -41,6 +45,9 @@ struct ProjectionResult {
   /// reference i, the last row the constant; columns torques 1..n then positions 1..n.
   Eigen::MatrixXd fir;
   std::vector<ProjectionTest> tests;  ///< every order tried (the chosen one last)
+  /// The projection onto the lagged-reference span on the window's samples (rank: the Gram's
+  /// numerical rank, 2H + 1 for references that share H harmonics whatever the run length).
+  std::shared_ptr<const SignalProjector> projector;
 };
 
 /// Estimates the non-causal multi-input FIR u_j(t) = Σ_i Σ_{k=−M1}^{M2} s_{jik}·r_i(t − k) + c_j

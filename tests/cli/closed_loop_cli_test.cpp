@@ -1,0 +1,139 @@
+// identify --closed-loop projection|spectral, --estimator ml, --repeat through the command line:
+// a 4-harmonic planar2 reference written here, run by `dynid simulate --controller pid` (native
+// plant, noise fed back), then identify; and the bad inputs of issue 13 item 8, one error line
+// each.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "dynid/excitation/fourier_trajectory.hpp"
+#include "dynid/excitation/trajectory_samples.hpp"
+#include "dynid/io/csv_writer.hpp"
+#include "support/cli_run.hpp"
+#include "support/closed_loop_runs.hpp"
+
+namespace dynid {
+namespace {
+
+std::filesystem::path scratch() {
+  const auto dir = std::filesystem::path(::testing::TempDir()) / "closed_loop_cli";
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+testing::CliResult run(const std::string& args) {
+  return testing::run_dynid(args, scratch());
+}
+
+nlohmann::json load(const std::string& path) {
+  std::ifstream f(path);
+  return nlohmann::json::parse(f);
+}
+
+std::string path(const std::string& name) {
+  return (scratch() / name).string();
+}
+
+// One period of the planar2 test reference at 100 Hz, then 4 periods under a plain PID.
+std::string plain_pid_run() {
+  static const std::string out = [] {
+    const TrajectorySamples tr =
+        sample_trajectory(FourierTrajectory(testing::planar2_reference()), 100.0, false);
+    Eigen::MatrixXd data(tr.t.size(), 7);
+    data << tr.t, tr.q, tr.dq, tr.ddq;
+    write_csv(path("reference.csv"), {"t", "q1", "q2", "dq1", "dq2", "ddq1", "ddq2"}, data);
+    const auto r = run("simulate --robot planar2 --trajectory " + path("reference.csv") +
+                       " --engine native --controller pid --periods 4 --position-noise 1e-3 "
+                       "--torque-noise 0.1 --seed 5 --out " +
+                       path("run.csv"));
+    EXPECT_EQ(r.code, 0) << r.err;
+    return path("run.csv");
+  }();
+  return out;
+}
+
+TEST(ClosedLoopCli, ProjectionSpectralAndRepeatWriteTheirJson) {
+  const std::string data = plain_pid_run();
+  auto r = run("identify --robot planar2 --data " + data +
+               " --closed-loop projection --repeat periods --out " + path("projection.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  nlohmann::json j = load(path("projection.json"));
+  EXPECT_EQ(j["closed_loop"]["method"], "projection");
+  EXPECT_GE(j["closed_loop"]["M1"].get<int>(), 2);
+  ASSERT_EQ(j["closed_loop"]["correlation"].size(), 2u);
+  EXPECT_LT(std::abs(j["closed_loop"]["correlation"][0].get<double>()), 1e-6);
+  EXPECT_EQ(j["options"]["closed_loop"], "projection");
+  EXPECT_EQ(j["repeated"]["n"], 4);
+  ASSERT_EQ(j["repeated"]["parameters"].size(), j["parameters"].size());
+  const auto& first = j["repeated"]["parameters"][0];
+  // Table 3's column: t_0.9995(3)/sqrt(3) = 12.924/1.7321 = 7.4617 times the std.
+  EXPECT_NEAR(first["ci_half_width"].get<double>() / first["std"].get<double>(), 7.4617, 1e-3);
+
+  r = run("identify --robot planar2 --data " + data + " --closed-loop spectral --out " +
+          path("spectral.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  j = load(path("spectral.json"));
+  EXPECT_EQ(j["closed_loop"]["method"], "spectral");
+  EXPECT_NEAR(j["closed_loop"]["spectrum"]["f0_hz"].get<double>(), 0.2, 1e-9);
+  EXPECT_EQ(j["closed_loop"]["spectrum"]["lines"], nlohmann::json({1, 2, 3, 4}));
+  EXPECT_EQ(j["closed_loop"]["dimensions_per_channel"], 9);
+
+  r = run("identify --robot planar2 --data " + data +
+          " --estimator ml --noise-std q=1e-3,tau=0.1 --out " + path("ml.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  j = load(path("ml.json"));
+  EXPECT_NE(j["choices"]["noise"].get<std::string>().find("given"), std::string::npos);
+  EXPECT_NE(j["choices"]["covariance"].get<std::string>().find("maximum likelihood"),
+            std::string::npos);
+}
+
+// One `error:` line, the exit code, and no result file.
+void expect_error(const std::string& args, int code, const std::string& text) {
+  std::filesystem::remove(path("bad.json"));
+  const auto r = run(args + " --out " + path("bad.json"));
+  EXPECT_EQ(r.code, code) << args << "\n" << r.err;
+  EXPECT_EQ(testing::error_contract_problem(r.err), "") << r.err;
+  EXPECT_NE(r.err.find(text), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(path("bad.json")));
+}
+
+TEST(ClosedLoopCli, BadInputIsOneErrorLine) {
+  const std::string data = plain_pid_run();
+  const std::string id = "identify --robot planar2 --data ";
+  // No reference columns: the reference itself has no qr*.
+  Eigen::MatrixXd plain(200, 5);
+  for (int k = 0; k < 200; ++k) {
+    const double t = 0.01 * k;
+    plain.row(k) << t, std::sin(t), std::cos(t), 0.1 * std::sin(3 * t), 0.2;
+  }
+  write_csv(path("no_qr.csv"), {"t", "q1", "q2", "tau1", "tau2"}, plain);
+  expect_error(id + path("no_qr.csv") + " --closed-loop projection", 1,
+               "error: closed-loop identification needs the reference columns qr1..qr2");
+  Eigen::MatrixXd flat(200, 7);
+  flat << plain.leftCols(3), plain.col(1), Eigen::VectorXd::Constant(200, 0.3), plain.rightCols(2);
+  write_csv(path("flat_qr.csv"), {"t", "q1", "q2", "qr1", "qr2", "tau1", "tau2"}, flat);
+  expect_error(id + path("flat_qr.csv") + " --closed-loop projection", 1,
+               "error: reference qr2 is constant (0.3)");
+  expect_error(id + data + " --closed-loop projection --fir 5000,5000", 1,
+               "error: FIR orders M1 = 5000, M2 = 5000 need at least");
+  expect_error(id + data + " --fir 4,4", 2, "error: --fir sets the projection's FIR orders");
+  expect_error(id + data + " --closed-loop projection --fir 4", 2, "error: --fir '4' is not M1,M2");
+  expect_error(id + data + " --closed-loop nonsense", 2, "error: --closed-loop must be none");
+  expect_error(id + data + " --estimator ml --noise-std q=1e-3,tau=0", 1,
+               "error: maximum likelihood needs a torque noise standard deviation > 0");
+  expect_error(id + data + " --estimator ml --noise-std q=-1", 2,
+               "error: --noise-std q=-1 is not a finite std >= 0");
+  expect_error(id + data + " --noise-std tau=1", 2, "error: --noise and --noise-std are the noise");
+  expect_error(id + path("no_qr.csv") + " --repeat periods", 1,
+               "error: --repeat periods finds the period from the reference");
+  expect_error(id + data + " --repeat runs", 1, "error: --repeat needs at least 2 runs");
+  expect_error(id + data + " --closed-loop projection --estimator ml", 2,
+               "error: --estimator ml models the noise of each sample");
+}
+
+}  // namespace
+}  // namespace dynid
