@@ -6,6 +6,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -21,6 +22,7 @@
 #include "dynid/io/streaming_identification.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/report/experiment_report.hpp"
+#include "dynid/report/html_report.hpp"
 #include "dynid/report/identification_report.hpp"
 #include "dynid/sim/simulate_reference.hpp"
 
@@ -52,6 +54,7 @@ struct IdentifyCliOptions {
   int joint = 0;                       // --joint (gravity, friction, decoupled), 1-based
   std::string params;                  // --params (friction: compensation model)
   bool physical = false;               // --physical
+  std::string report;                  // --report
 };
 
 // The run named by `flag` must be a readable file (so the error names the flag the user gave).
@@ -107,6 +110,20 @@ void echo_choices(const char* command, const RunFileReport& read,
   for (const auto& note : read.notes) std::cerr << command << ": " << one_line(note) << '\n';
   for (const auto& [key, value] : choices)
     std::cerr << command << ": " << key << ": " << one_line(value) << '\n';
+}
+
+std::vector<std::string> joint_names(const Model& model) {
+  std::vector<std::string> names;
+  for (const auto& joint : model.joints) names.push_back(joint.name);
+  return names;
+}
+
+// --report: the result just written, as one HTML page.
+void write_report(const std::string& path, const std::string& source,
+                  const nlohmann::json& result) {
+  if (path.empty()) return;
+  write_html_report(path, {{source, result}}, {});
+  std::cout << "wrote " << path << '\n';
 }
 
 void warn(const std::string& text) {
@@ -373,6 +390,7 @@ void run_experiment(const IdentifyCliOptions& o, const IdentifyOptions& options,
   std::cout << experiment_table(result);
   write_json(o.out, result);
   std::cout << "wrote " << o.out << '\n';
+  write_report(o.report, o.out, result);
 }
 
 void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
@@ -409,6 +427,7 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   for (const auto& run : o.runs) require_readable(run, "--data");
   require_output_folder(o.out, "--out");
   require_output_folder(o.history, "--history");
+  require_output_folder(o.report, "--report");
   if (o.stream &&
       (!o.torque_scale.empty() || !file.window.empty() || columns_by_position(file.columns))) {
     throw UsageError(
@@ -441,6 +460,21 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   if (o.runs.size() > 1) used["data_runs"] = o.runs;
   if (!o.history.empty()) used["history"] = o.history;
   nlohmann::json out = identification_to_json(model, result, used);
+  // What a report plots: the first run's measured and predicted torques as processed (the
+  // streaming mode keeps no run), and the RLS history.
+  std::optional<ValidationResult> first_run_fit;
+  if (!records.empty()) {
+    IdentifyOptions same = options;
+    same.signal.cutoff_hz = result.processed.cutoff_hz;
+    try {
+      first_run_fit =
+          validate_torques(model, records.front(), result.names, result.estimate.x, same);
+      out["plot"] = prediction_plot_json(*first_run_fit, joint_names(model));
+    } catch (const Error& e) {  // the result stands without its plot
+      warn(std::string("no torque plot in the result: ") + e.what());
+    }
+    if (result.history_x.rows() > 0) out["plot"]["history"] = rls_history_plot_json(result);
+  }
   if (o.physical) {
     if (!result.not_excited.empty()) {
       throw Error(
@@ -460,7 +494,9 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     const double physical_error =
         validate_torques(model, first, result.names, fit.theta_b, same).relative_error_all;
     const double free_error =
-        validate_torques(model, first, result.names, result.estimate.x, same).relative_error_all;
+        first_run_fit ? first_run_fit->relative_error_all
+                      : validate_torques(model, first, result.names, result.estimate.x, same)
+                            .relative_error_all;
     physical_parameters_to_json(fit, physical_error, free_error, out);
     std::cout << physical_parameters_text(fit, physical_error, free_error);
   }
@@ -470,6 +506,7 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     write_rls_history(o.history, result);
     std::cout << "wrote " << o.history << '\n';
   }
+  write_report(o.report, o.out, out);
 }
 
 // A usage error raised by an option value read from a result file: the file and its key are at
@@ -496,6 +533,7 @@ Error file_option_error(const UsageError& e, const std::string& path) {
 struct ValidateCliOptions {
   std::string robot, params, data, json, columns, mode = "torque", trajectory, engine = "mujoco";
   std::string predicted;
+  std::string report;  // --report
   double rate = 0.0;
   std::vector<double> zero_velocity;
   std::vector<double> torque_scale;
@@ -519,6 +557,7 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
   require_readable(v.data, "--data");
   require_output_folder(v.json, "--json");
   require_output_folder(v.predicted, "--predicted");
+  require_output_folder(v.report, "--report");
   if (v.mode == "simulation") {
     require_readable(v.trajectory, "--trajectory");
     if (!v.predicted.empty()) warn("--predicted has no effect with --mode simulation");
@@ -593,10 +632,12 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
         validate_run_by_simulation(identified_model(model, names, values, options), ref.t, ref.q,
                                    ref.dq, ref.ddq, record.q, record.tau, plant);
     std::cout << simulation_validation_table(model, sv);
+    const nlohmann::json out = simulation_validation_to_json(model, sv);
     if (!v.json.empty()) {
-      write_json(v.json, simulation_validation_to_json(model, sv));
+      write_json(v.json, out);
       std::cout << "wrote " << v.json << '\n';
     }
+    write_report(v.report, v.json.empty() ? v.data : v.json, out);
     return;
   }
   ValidationResult result;
@@ -616,10 +657,13 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
                 "' are implausibly large; check both files and their units");
   }
   std::cout << validation_table(model, result);
+  nlohmann::json out = validation_to_json(model, result);
+  out["plot"] = prediction_plot_json(result, joint_names(model));
   if (!v.json.empty()) {
-    write_json(v.json, validation_to_json(model, result));
+    write_json(v.json, out);
     std::cout << "wrote " << v.json << '\n';
   }
+  write_report(v.report, v.json.empty() ? v.data : v.json, out);
   if (!v.predicted.empty()) {
     write_validation_predictions(v.predicted, result);
     std::cout << "wrote " << v.predicted << '\n';
@@ -641,6 +685,8 @@ void add_identify_command(CLI::App& app) {
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_option("--out,-o", o->out, "Result JSON file")->required();
+  cmd->add_option("--report", o->report,
+                  "Also write a self-contained HTML report of the result (as dynid report)");
   cmd->add_option("--history", o->history,
                   "With --estimator rls: write the estimate after every equation as CSV (t, then "
                   "NAME and NAME_std per parameter), to watch when each parameter settles");
@@ -692,7 +738,11 @@ void add_validate_command(CLI::App& app) {
   cmd->add_option("--robot,-r", v->robot, "Built-in robot name or .urdf/.yaml model")->required();
   cmd->add_option("--params,-p", v->params, "result.json written by dynid identify")->required();
   cmd->add_option("--data,-d", v->data, "Run CSV to predict (same format as identify)")->required();
-  cmd->add_option("--json", v->json, "Write the per-joint errors as JSON");
+  cmd->add_option("--json", v->json,
+                  "Write the per-joint errors as JSON (with `plot`: measured and predicted "
+                  "torques decimated for display, residual histogram)");
+  cmd->add_option("--report", v->report,
+                  "Also write a self-contained HTML report of the validation (as dynid report)");
   cmd->add_option("--mode", v->mode,
                   "torque (predict the measured torques) or simulation (simulate the identified "
                   "model under the same reference and controller, as in B. Bona, A. Curatella, "

@@ -39,4 +39,7 @@ void add_average_command(CLI::App& app);
 /// `dynid payload`: a gripped load's parameters from a wrist force/torque sensor (cmd_payload.cpp).
 void add_payload_command(CLI::App& app);
 
+/// `dynid report`: self-contained HTML page with plots of result JSON files (cmd_report.cpp).
+void add_report_command(CLI::App& app);
+
 }  // namespace dynid::cli
