@@ -13,6 +13,7 @@
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
+#include "dynid/common/progress.hpp"
 #include "dynid/estimation/decoupled_model.hpp"
 #include "dynid/estimation/friction_experiment.hpp"
 #include "dynid/estimation/gravity_experiment.hpp"
@@ -55,6 +56,7 @@ struct IdentifyCliOptions {
   std::string params;                  // --params (friction: compensation model)
   bool physical = false;               // --physical
   std::string report;                  // --report
+  bool quiet = false;                  // --quiet
 };
 
 // The run named by `flag` must be a readable file (so the error names the flag the user gave).
@@ -447,8 +449,16 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     result = identify_stream(model, o.data, file, options, {o.threads, true});
   } else {
     // Each run read on its own (same column mapping, window and torque scale for every run).
-    for (const auto& run : o.runs) records.push_back(read_joint_record(run, model, file, &read));
+    // Reading a big file is most of the wait; the stages after it report as one step.
+    ProgressLine progress("identify", progress_wanted(o.quiet));
+    const double steps = static_cast<double>(o.runs.size() + 1);
+    for (size_t i = 0; i < o.runs.size(); ++i) {
+      progress.update(static_cast<double>(i) / steps, "reading " + o.runs[i]);
+      records.push_back(read_joint_record(o.runs[i], model, file, &read));
+    }
+    progress.update((steps - 1.0) / steps, "filtering and estimating");
     result = identify(model, records, options);
+    progress.finish();
     for (size_t i = 0; i < result.runs.size(); ++i) result.runs[i].file = o.runs[i];
   }
   echo_choices("identify", read, result.choices);
@@ -685,6 +695,8 @@ void add_identify_command(CLI::App& app) {
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_option("--out,-o", o->out, "Result JSON file")->required();
+  cmd->add_flag("--quiet,-q", o->quiet,
+                "No progress line on stderr (shown only when stderr is a terminal)");
   cmd->add_option("--report", o->report,
                   "Also write a self-contained HTML report of the result (as dynid report)");
   cmd->add_option("--history", o->history,

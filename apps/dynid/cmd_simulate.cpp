@@ -5,6 +5,7 @@
 
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
+#include "dynid/common/progress.hpp"
 #include "dynid/io/csv_writer.hpp"
 #include "dynid/io/joint_record_file.hpp"
 #include "dynid/model/robots.hpp"
@@ -20,6 +21,7 @@ struct SimulateCliOptions {
   unsigned seed = 1;
   double position_noise = 0.0, torque_noise = 0.0, counts_per_rev = 0.0;
   bool truth = false;
+  bool quiet = false;  // --quiet
 };
 
 // The gains file written next to the run: run.csv -> run.gains.json (docs/cli.md).
@@ -52,7 +54,10 @@ void run(const SimulateCliOptions& o) {
   s.loop.periods = o.periods;
   s.loop.record_truth = o.truth;
   PidOptions pid;
+  ProgressLine progress("simulate", progress_wanted(o.quiet));
+  s.loop.progress = progress.callback();
   const ClosedLoopResult r = simulate_reference(model, ref.t, ref.q, ref.dq, ref.ddq, s, &pid);
+  progress.finish();
   const Eigen::Index n = model.dof();
   std::vector<std::string> cols = {"t"};
   std::vector<const char*> prefixes = {"qr", "q", "tau"};
@@ -105,6 +110,8 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--counts-per-rev", o->counts_per_rev,
                   "Encoder counts per revolution; 0 = exact");
   cmd->add_option("--delay", o->delay, "Measurement delay [samples]");
+  cmd->add_flag("--quiet,-q", o->quiet,
+                "No progress line on stderr (shown only when stderr is a terminal)");
   cmd->add_flag("--truth", o->truth,
                 "Also write the true dq*, ddq* (real robots rarely measure them)");
   cmd->callback([o] { run(*o); });

@@ -613,7 +613,12 @@ constexpr const char* kRenderer = R"JS(
       var bars = c.low.map(function (l, k) { return (l === null || c.high[k] === null) ? null : [l, c.high[k]]; });
       n = count(bars) + count(c.value);
       options.indexAxis = 'y';
-      options.scales = {x: {title: axis(c.x_label)}, y: {ticks: {autoSkip: false, font: {size: 10}}}};
+      // Intervals wider than the estimate itself run off a [-3, 5] axis (red, with their numbers
+      // in the tooltip) so that the well-determined ones stay readable.
+      var lo = Math.min.apply(null, c.low.filter(function (v) { return v !== null; }).concat([-1]));
+      var hi = Math.max.apply(null, c.high.filter(function (v) { return v !== null; }).concat([1]));
+      options.scales = {x: {title: axis(c.x_label), min: Math.max(-3, lo - 0.1), max: Math.min(5, hi + 0.1)},
+                        y: {ticks: {autoSkip: false, font: {size: 10}}}};
       options.plugins.tooltip = {callbacks: {label: function (ctx) { return c.tips[ctx.dataIndex]; }}};
       datasets.push({type: 'bar', label: 'confidence interval', data: bars,
                      backgroundColor: c.colors, barPercentage: 0.9, categoryPercentage: 0.9});

@@ -89,6 +89,8 @@ TEST_F(ReportCli, EveryResultKindRendersInChromium) {
           "--rate 50 --max-time 0 --starts 1 --max-evaluations 100 -o " +
           path("traj.csv") + " --json " + path("ex.json"));
   ASSERT_EQ(r.code, 0) << r.err;
+  // stderr is a file here: no progress line (its carriage-return redraws are for terminals).
+  EXPECT_EQ(r.err.find('\r'), std::string::npos) << r.err;
   // A result of a kind the report does not know: its scalar facts and parameters.
   std::ofstream(path("other.json"))
       << R"({"command": "future", "rms": 0.5, "parameters": [{"name": "k1", "value": 2.0,
