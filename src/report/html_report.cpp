@@ -169,6 +169,12 @@ void add_parameters(const Json& result, Json& section) {
 void add_joint_bars(const Json& values, const std::vector<std::string>& names,
                     const std::string& title, const std::string& y_label, Json& section) {
   if (!values.is_array() || values.empty()) return;
+  // A figure the result does not have (null everywhere, e.g. per-component RMS of a recursive
+  // fit) is said so, not drawn as an empty chart.
+  if (std::none_of(values.begin(), values.end(), [](const Json& v) { return v.is_number(); })) {
+    section["facts"].push_back({title, "not reported in this result"});
+    return;
+  }
   Json labels = Json::array(), ys = Json::array();
   for (size_t j = 0; j < values.size(); ++j) {
     labels.push_back(j < names.size() ? names[j] : std::to_string(j + 1));
