@@ -7,6 +7,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "dynid/common/error.hpp"
 #include "dynid/report/html_report.hpp"
 #include "dynid/workflow/demo.hpp"
 
@@ -35,6 +36,12 @@ void run(const DemoCliOptions& c) {
   o.periods = c.periods;
   o.mujoco = !c.native;
   o.seed = c.seed;
+  // A --report into a missing folder fails before the demo's work, not after it.
+  if (const auto folder = std::filesystem::path(c.report).parent_path();
+      !folder.empty() && !std::filesystem::is_directory(folder)) {
+    throw Error("--report '" + c.report + "': folder '" + folder.string() +
+                "' does not exist; create it or write elsewhere");
+  }
   const auto start = std::chrono::steady_clock::now();
   const DemoResult r = run_demo(o, [&](const std::string& line) {
     const double s =
