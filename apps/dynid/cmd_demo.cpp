@@ -1,11 +1,14 @@
 // `dynid demo`: the whole identification loop on a simulated robot (workflow/demo.hpp).
 #include <chrono>
 #include <ctime>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
 
 #include "commands.hpp"
+#include "dynid/common/error.hpp"
+#include "dynid/report/html_report.hpp"
 #include "dynid/workflow/demo.hpp"
 
 namespace dynid::cli {
@@ -16,6 +19,7 @@ struct DemoCliOptions {
   int periods = 25;
   bool native = false;
   unsigned seed = 7;
+  std::string report;  // --report; default <out>/report.html
 };
 
 std::string default_folder() {
@@ -32,13 +36,29 @@ void run(const DemoCliOptions& c) {
   o.periods = c.periods;
   o.mujoco = !c.native;
   o.seed = c.seed;
+  // A --report into a missing folder fails before the demo's work, not after it.
+  if (const auto folder = std::filesystem::path(c.report).parent_path();
+      !folder.empty() && !std::filesystem::is_directory(folder)) {
+    throw Error("--report '" + c.report + "': folder '" + folder.string() +
+                "' does not exist; create it or write elsewhere");
+  }
   const auto start = std::chrono::steady_clock::now();
   const DemoResult r = run_demo(o, [&](const std::string& line) {
     const double s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::cerr << "[" << static_cast<int>(s) << " s] " << line << std::endl;
   });
-  std::cout << r.table << "files written to " << o.out_dir << '\n';
+  // The report of the files the demo wrote, as `dynid report --in` would make it.
+  const std::filesystem::path dir(o.out_dir);
+  std::vector<ReportInput> inputs;
+  for (const char* name : {"excitation.json", "result.json", "validation.json"}) {
+    inputs.push_back(read_report_input((dir / name).string()));
+  }
+  const std::string report = c.report.empty() ? (dir / "report.html").string() : c.report;
+  HtmlReportOptions options;
+  options.title = "dynid demo: " + o.robot;
+  write_html_report(report, inputs, options);
+  std::cout << r.table << "files written to " << o.out_dir << "; report " << report << '\n';
 }
 
 }  // namespace
@@ -55,6 +75,9 @@ void add_demo_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--native", c->native, "Use dynid's own plant instead of MuJoCo");
   cmd->add_option("--seed", c->seed, "Noise and optimiser seed")->capture_default_str();
+  cmd->add_option("--report", c->report,
+                  "HTML report of the run (excitation, identification, validation); default "
+                  "report.html in the output folder");
   cmd->callback([c] { run(*c); });
 }
 

@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
+#include "dynid/common/progress.hpp"
 #include "dynid/excitation/bang_bang_trajectory.hpp"
 #include "dynid/excitation/fourier_trajectory.hpp"
 #include "dynid/excitation/polynomial_spline.hpp"
@@ -27,6 +28,7 @@ struct ExciteCliOptions {
   int harmonics = 5, starts = 4, max_evaluations = 3000;
   double f0 = 0.1, f_max = 0.0, rate = 100.0, max_time = 10.0, z_min = -1e300;
   double limit_fraction = 1.0;
+  bool quiet = false;  // --quiet
   std::vector<double> dq_max, ddq_max, tau_max;
   unsigned seed = 20261123;
   bool no_rest = false;
@@ -234,7 +236,10 @@ void run_excite(const ExciteCliOptions& o) {
                      " leaves no free coefficient once the trajectory starts and ends at rest "
                      "(dq = ddq = 0): use --harmonics 2 or more, or --no-rest");
   }
+  ProgressLine progress("excite", progress_wanted(o.quiet));
+  options.progress = progress.callback();
   const ExcitationResult result = optimize_excitation(model, options);
+  progress.finish();
   if (!std::isfinite(result.condition_number)) {
     throw Error("the optimised trajectory of '" + o.robot +
                 "' does not excite every base parameter (condition number infinite); use more "
@@ -285,6 +290,8 @@ void add_excite_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--max-time", o->max_time, "Wall-clock budget [s]; 0 = none (reproducible)")
       ->capture_default_str();
+  cmd->add_flag("--quiet,-q", o->quiet,
+                "No progress line on stderr (shown only when stderr is a terminal)");
   cmd->add_flag("--no-rest", o->no_rest,
                 "Do not force zero velocity/acceleration at start and end");
   cmd->add_option("--family", o->family,

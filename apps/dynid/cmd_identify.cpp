@@ -6,12 +6,14 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
+#include "dynid/common/progress.hpp"
 #include "dynid/estimation/decoupled_model.hpp"
 #include "dynid/estimation/friction_experiment.hpp"
 #include "dynid/estimation/gravity_experiment.hpp"
@@ -23,6 +25,7 @@
 #include "dynid/model/robots.hpp"
 #include "dynid/report/control_report.hpp"
 #include "dynid/report/experiment_report.hpp"
+#include "dynid/report/html_report.hpp"
 #include "dynid/report/identification_report.hpp"
 #include "dynid/sim/pid_gains.hpp"
 #include "dynid/sim/simulate_reference.hpp"
@@ -62,6 +65,8 @@ struct IdentifyCliOptions {
   std::string fir;                          // --fir M1,M2
   std::string noise, noise_std;             // --noise FILE, --noise-std q=S,tau=S (ml)
   std::string repeat;                       // --repeat periods|runs
+  std::string report;                       // --report
+  bool quiet = false;                       // --quiet
 };
 
 // The run named by `flag` must be a readable file (so the error names the flag the user gave).
@@ -117,6 +122,20 @@ void echo_choices(const char* command, const RunFileReport& read,
   for (const auto& note : read.notes) std::cerr << command << ": " << one_line(note) << '\n';
   for (const auto& [key, value] : choices)
     std::cerr << command << ": " << key << ": " << one_line(value) << '\n';
+}
+
+std::vector<std::string> joint_names(const Model& model) {
+  std::vector<std::string> names;
+  for (const auto& joint : model.joints) names.push_back(joint.name);
+  return names;
+}
+
+// --report: the result just written, as one HTML page.
+void write_report(const std::string& path, const std::string& source,
+                  const nlohmann::json& result) {
+  if (path.empty()) return;
+  write_html_report(path, {{source, result}}, {});
+  std::cout << "wrote " << path << '\n';
 }
 
 void warn(const std::string& text) {
@@ -428,6 +447,7 @@ void run_experiment(const IdentifyCliOptions& o, const IdentifyOptions& options,
   std::cout << experiment_table(result);
   write_json(o.out, result);
   std::cout << "wrote " << o.out << '\n';
+  write_report(o.report, o.out, result);
 }
 
 void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
@@ -476,6 +496,7 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   for (const auto& run : o.runs) require_readable(run, "--data");
   require_output_folder(o.out, "--out");
   require_output_folder(o.history, "--history");
+  require_output_folder(o.report, "--report");
   if (o.stream &&
       (!o.torque_scale.empty() || !file.window.empty() || columns_by_position(file.columns))) {
     throw UsageError(
@@ -512,7 +533,14 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     result = identify_stream(model, o.data, file, options, {o.threads, true});
   } else {
     // Each run read on its own (same column mapping, window and torque scale for every run).
-    for (const auto& run : o.runs) records.push_back(read_joint_record(run, model, file, &read));
+    // Reading a big file is most of the wait; the stages after it report as one step.
+    ProgressLine progress("identify", progress_wanted(o.quiet));
+    const double steps = static_cast<double>(o.runs.size() + 1);
+    for (size_t i = 0; i < o.runs.size(); ++i) {
+      progress.update(static_cast<double>(i) / steps, "reading " + o.runs[i]);
+      records.push_back(read_joint_record(o.runs[i], model, file, &read));
+    }
+    progress.update((steps - 1.0) / steps, "filtering and estimating");
     for (const auto& f : o.friction_known) {
       const IdentifiedResultFile known = read_identification_result(f);
       if (!known.robot.empty() && known.robot != model.name) {
@@ -534,6 +562,7 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
       repeated = identify_repeated(model, records, references, options,
                                    o.repeat == "runs" ? RepeatOver::kRuns : RepeatOver::kPeriods);
     }
+    progress.finish();
     for (size_t i = 0; i < result.runs.size(); ++i) result.runs[i].file = o.runs[i];
   }
   echo_choices("identify", read, result.choices);
@@ -550,6 +579,21 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     out["repeated"] = repeated_to_json(repeated, o.repeat);
     std::cout << "repeated over " << repeated.n << " " << o.repeat
               << ": mean, std and t/sqrt(n-1)*std per parameter in " << o.out << '\n';
+  }
+  // What a report plots: the first run's measured and predicted torques as processed (the
+  // streaming mode keeps no run), and the RLS history.
+  std::optional<ValidationResult> first_run_fit;
+  if (!records.empty()) {
+    IdentifyOptions same = options;
+    same.signal.cutoff_hz = result.processed.cutoff_hz;
+    try {
+      first_run_fit = validate_torques(model, records.front(), result.names, result.estimate.x,
+                                       same, result.not_excited);
+      out["plot"] = prediction_plot_json(*first_run_fit, joint_names(model));
+    } catch (const Error& e) {  // the result stands without its plot
+      warn(std::string("no torque plot in the result: ") + e.what());
+    }
+    if (result.history_x.rows() > 0) out["plot"]["history"] = rls_history_plot_json(result);
   }
   if (o.physical) {
     if (!result.not_excited.empty()) {
@@ -570,7 +614,9 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     const double physical_error =
         validate_torques(model, first, result.names, fit.theta_b, same).relative_error_all;
     const double free_error =
-        validate_torques(model, first, result.names, result.estimate.x, same).relative_error_all;
+        first_run_fit ? first_run_fit->relative_error_all
+                      : validate_torques(model, first, result.names, result.estimate.x, same)
+                            .relative_error_all;
     physical_parameters_to_json(fit, physical_error, free_error, out);
     std::cout << physical_parameters_text(fit, physical_error, free_error);
   }
@@ -580,6 +626,7 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     write_rls_history(o.history, result);
     std::cout << "wrote " << o.history << '\n';
   }
+  write_report(o.report, o.out, out);
 }
 
 // A usage error raised by an option value read from a result file: the file and its key are at
@@ -607,6 +654,7 @@ struct ValidateCliOptions {
   std::string robot, params, data, json, columns, mode = "torque", trajectory, engine = "mujoco";
   std::string predicted;
   std::string controller, gains, histograms;  // --mode simulation: the run's loop, error PDFs
+  std::string report;                         // --report
   double rate = 0.0;
   std::vector<double> zero_velocity;
   std::vector<double> torque_scale;
@@ -630,6 +678,7 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
   require_readable(v.data, "--data");
   require_output_folder(v.json, "--json");
   require_output_folder(v.predicted, "--predicted");
+  require_output_folder(v.report, "--report");
   if (v.mode == "simulation") {
     require_readable(v.trajectory, "--trajectory");
     if (!v.predicted.empty()) warn("--predicted has no effect with --mode simulation");
@@ -697,10 +746,12 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
       write_error_histograms(v.histograms, model, sv);
       std::cout << "wrote " << v.histograms << '\n';
     }
+    const nlohmann::json out = simulation_validation_to_json(model, sv);
     if (!v.json.empty()) {
-      write_json(v.json, simulation_validation_to_json(model, sv));
+      write_json(v.json, out);
       std::cout << "wrote " << v.json << '\n';
     }
+    write_report(v.report, v.json.empty() ? v.data : v.json, out);
     return;
   }
   ValidationResult result;
@@ -720,10 +771,13 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
                 "' are implausibly large; check both files and their units");
   }
   std::cout << validation_table(model, result);
+  nlohmann::json out = validation_to_json(model, result);
+  out["plot"] = prediction_plot_json(result, joint_names(model));
   if (!v.json.empty()) {
-    write_json(v.json, validation_to_json(model, result));
+    write_json(v.json, out);
     std::cout << "wrote " << v.json << '\n';
   }
+  write_report(v.report, v.json.empty() ? v.data : v.json, out);
   if (!v.predicted.empty()) {
     write_validation_predictions(v.predicted, result);
     std::cout << "wrote " << v.predicted << '\n';
@@ -797,6 +851,10 @@ void add_identify_command(CLI::App& app) {
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_option("--out,-o", o->out, "Result JSON file")->required();
+  cmd->add_flag("--quiet,-q", o->quiet,
+                "No progress line on stderr (shown only when stderr is a terminal)");
+  cmd->add_option("--report", o->report,
+                  "Also write a self-contained HTML report of the result (as dynid report)");
   cmd->add_option("--history", o->history,
                   "With --estimator rls: write the estimate after every equation as CSV (t, then "
                   "NAME and NAME_std per parameter), to watch when each parameter settles");
@@ -876,7 +934,11 @@ void add_validate_command(CLI::App& app) {
   cmd->add_option("--robot,-r", v->robot, "Built-in robot name or .urdf/.yaml model")->required();
   cmd->add_option("--params,-p", v->params, "result.json written by dynid identify")->required();
   cmd->add_option("--data,-d", v->data, "Run CSV to predict (same format as identify)")->required();
-  cmd->add_option("--json", v->json, "Write the per-joint errors as JSON");
+  cmd->add_option("--json", v->json,
+                  "Write the per-joint errors as JSON (with `plot`: measured and predicted "
+                  "torques decimated for display, residual histogram)");
+  cmd->add_option("--report", v->report,
+                  "Also write a self-contained HTML report of the validation (as dynid report)");
   cmd->add_option("--mode", v->mode,
                   "torque (predict the measured torques) or simulation (simulate the identified "
                   "model under the same reference and controller, as in B. Bona, A. Curatella, "

@@ -22,6 +22,7 @@
 #include "dynid/io/joint_record_file.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/model/robots.hpp"
+#include "dynid/report/html_report.hpp"
 #include "dynid/version.hpp"
 #include "flag_checks.hpp"
 #include "result_options.hpp"
@@ -32,6 +33,7 @@ namespace {
 struct PayloadCliOptions {
   std::string data, robot, sensor_link, sensor_pose, out, history, columns;
   std::string link, reference, frame;  // joint-torque mode
+  std::string report;                  // --report: HTML page of the result
   std::string model = "differential";
   std::string estimator = "ols";
   std::string gravity = "0 0 -9.81";
@@ -143,6 +145,10 @@ void write_result(const PayloadCliOptions& cli, const LoadIdentificationResult& 
   if (r.physics.mass > 0.0) std::cout << ", c = " << r.physics.com.transpose() << " m";
   std::cout << (r.physics.consistent ? ", physically consistent" : ", NOT physically consistent")
             << "; wrote " << cli.out << '\n';
+  if (!cli.report.empty()) {
+    write_html_report(cli.report, {{cli.out, out}}, {});
+    std::cout << "wrote " << cli.report << '\n';
+  }
 }
 
 // The JSON of a load from joint torques: where it is expressed and which parameters the torques
@@ -248,6 +254,11 @@ void run_payload_from_torques(const PayloadCliOptions& cli, LoadIdentificationOp
 
 void run_payload(const PayloadCliOptions& cli) {
   if (cli.out.empty()) throw UsageError("--out is required: the JSON file to write");
+  if (const auto folder = std::filesystem::path(cli.report).parent_path();
+      !folder.empty() && !std::filesystem::is_directory(folder)) {
+    throw Error("--report '" + cli.report + "': folder '" + folder.string() +
+                "' does not exist; create it or write elsewhere");
+  }
   LoadEquationOptions equations;
   if (cli.model == "differential") {
     equations.model = LoadModelKind::kDifferential;
@@ -402,6 +413,8 @@ void add_payload_command(CLI::App& app) {
                   "frame) with optional wx wy wz, dwx dwy dwz, ax ay az (sensor frame)")
       ->required();
   cmd->add_option("--out,-o", o->out, "JSON result to write (atomically)")->required();
+  cmd->add_option("--report", o->report,
+                  "Also write a self-contained HTML report of the result (as dynid report)");
   cmd->add_option("--robot,-r", o->robot,
                   "Built-in robot name or .urdf / .yaml model: the sensor's motion comes from "
                   "its kinematics and q (dq, ddq derived and filtered as in identify)");

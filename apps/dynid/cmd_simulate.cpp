@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
+#include "dynid/common/progress.hpp"
 #include "dynid/io/csv_writer.hpp"
 #include "dynid/io/joint_record_file.hpp"
 #include "dynid/model/robots.hpp"
@@ -27,6 +28,7 @@ struct SimulateCliOptions {
   // A load behind a wrist force/torque sensor (issue 12 item 4).
   std::string payload, payload_link, sensor_pose;
   std::vector<double> wrench_noise;
+  bool quiet = false;  // --quiet
 };
 
 // The load of --payload on --payload-link at --sensor-pose, or none; usage errors name the flag.
@@ -90,8 +92,11 @@ void run(const SimulateCliOptions& o) {
   s.loop.periods = o.periods;
   s.loop.record_truth = o.truth || load.has_value();  // the wrench follows the true motion
   PidOptions pid;
+  ProgressLine progress("simulate", progress_wanted(o.quiet));
+  s.loop.progress = progress.callback();
   const ClosedLoopResult r = simulate_reference(load ? model_with_load(model, *load) : model, ref.t,
                                                 ref.q, ref.dq, ref.ddq, s, &pid);
+  progress.finish();
   const Eigen::Index n = model.dof();
   std::vector<std::string> cols = {"t"};
   std::vector<const char*> prefixes = {"qr", "q", "tau"};
@@ -168,6 +173,8 @@ void add_simulate_command(CLI::App& app) {
                   "With --payload: Gaussian noise std on the wrench, FORCE[,MOMENT] [N, N m] "
                   "(one value: the same on all six); seeded by --seed")
       ->delimiter(',');
+  cmd->add_flag("--quiet,-q", o->quiet,
+                "No progress line on stderr (shown only when stderr is a terminal)");
   cmd->add_flag("--truth", o->truth,
                 "Also write the true dq*, ddq* (real robots rarely measure them)");
   cmd->callback([o] { run(*o); });

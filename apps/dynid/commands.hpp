@@ -53,5 +53,7 @@ Model model_from_result(const Model& model, const std::string& params);
 
 /// `dynid export`: physically consistent parameters written as URDF (cmd_export.cpp).
 void add_export_command(CLI::App& app);
+/// `dynid report`: self-contained HTML page with plots of result JSON files (cmd_report.cpp).
+void add_report_command(CLI::App& app);
 
 }  // namespace dynid::cli

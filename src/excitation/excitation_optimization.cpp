@@ -625,6 +625,10 @@ ExcitationResult optimize_excitation(const Model& model, const ExcitationOptions
       }
       ctx.compute(x.data());
       if (m == 0 || ctx.g.maxCoeff() <= 0.0) ++starts_feasible;
+      if (options.progress) {
+        options.progress((start + 1.0) / options.starts, "start " + std::to_string(start + 1) +
+                                                             "/" + std::to_string(options.starts));
+      }
     } catch (const nlopt::forced_stop&) {
       break;  // out of time during the start's set-up
     }

@@ -67,6 +67,10 @@ ClosedLoopResult run_closed_loop(const Reference& reference, PidController& cont
   }
   Eigen::VectorXd qr(n), dqr(n), ddqr(n), y(n), tau(n), measured(n), ddq(n);
   for (long k = 0; k < total; ++k) {
+    if (options.progress && k % 1000 == 0) {
+      options.progress(static_cast<double>(k) / total,
+                       "sample " + std::to_string(k) + "/" + std::to_string(total));
+    }
     const long i = k % period;
     qr = reference.q.row(i).transpose();
     dqr = reference.dq.row(i).transpose();

@@ -12,6 +12,7 @@
 #include "dynid/io/json_writer.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/report/excitation_report.hpp"
+#include "dynid/report/html_report.hpp"
 #include "dynid/report/identification_report.hpp"
 #include "dynid/signal/period_averaging.hpp"
 #include "dynid/sim/closed_loop.hpp"
@@ -149,7 +150,14 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
                          {"torque_offset_s", io.signal.torque_time_offset},
                          {"filter_coulomb_columns", io.signal.filter_coulomb_columns},
                          {"zero_velocity", io.signal.zero_velocity}};
-  write_json(file("result.json"), identification_to_json(model, out.identification, used));
+  nlohmann::json result = identification_to_json(model, out.identification, used);
+  std::vector<std::string> joint_names;
+  for (const auto& joint : model.joints) joint_names.push_back(joint.name);
+  // What the report plots: the averaged period's measured and predicted torques.
+  result["plot"] = prediction_plot_json(
+      validate_torques(model, rec, out.identification.names, out.identification.estimate.x, io),
+      joint_names);
+  write_json(file("result.json"), result);
 
   progress("4/6 validating on a trapezoidal move");
   Eigen::MatrixXd way(n, 3);
@@ -177,7 +185,9 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
   vo.signal.zero_velocity.assign(fit_threshold.data(), fit_threshold.data() + fit_threshold.size());
   out.validation =
       validate_torques(model, vrec, out.identification.names, out.identification.estimate.x, vo);
-  write_json(file("validation.json"), validation_to_json(model, out.validation));
+  nlohmann::json validation = validation_to_json(model, out.validation);
+  validation["plot"] = prediction_plot_json(out.validation, joint_names);
+  write_json(file("validation.json"), validation);
 
   progress("5/6 comparing with the true parameters");
   std::ostringstream t;

@@ -16,6 +16,7 @@
 #include "dynid/io/csv_writer.hpp"
 #include "dynid/model/robots.hpp"
 #include "support/cli_run.hpp"
+#include "support/headless_chromium.hpp"
 #include "support/load_rig.hpp"
 
 namespace dynid {
@@ -194,13 +195,22 @@ TEST_F(PayloadCli, QuaternionLogAndStandingJointPoses) {
 
 TEST_F(PayloadCli, RecursiveEstimatorWritesItsHistory) {
   write_joint_run(path("run.csv"), 2, 200.0);
-  const auto r = run("payload --robot puma560 --sensor-link link6 --data " + path("run.csv") +
-                     " --sensor-pose '0.01 0 0.05 0 0 0.3' --estimator rls --history " +
-                     path("history.csv") + " --out " + path("load.json"));
+  const auto r =
+      run("payload --robot puma560 --sensor-link link6 --data " + path("run.csv") +
+          " --sensor-pose '0.01 0 0.05 0 0 0.3' --estimator rls --history " + path("history.csv") +
+          " --out " + path("load.json") + " --report " + path("load.html"));
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string history = testing::slurp(dir_ / "history.csv");
   EXPECT_EQ(history.rfind("row,m,mcx,mcy,mcz,Ixx", 0), 0u) << history.substr(0, 80);
   EXPECT_NEAR(json("load.json").at("mass").get<double>(), 1.910, 0.02);
+  // --report: a page headless Chromium renders without a script error or an empty chart.
+  const testing::RenderedReport page = testing::render_in_chromium(path("load.html"), dir_);
+  ASSERT_EQ(page.sections.size(), 1u) << page.log;
+  EXPECT_EQ(page.sections[0].at("data-kind"), "payload");
+  EXPECT_NE(page.sections[0].at("data-charts"), "0");
+  EXPECT_EQ(page.body.at("data-errors"), "0") << page.log;
+  EXPECT_EQ(page.body.at("data-empty-charts"), "0");
+  EXPECT_EQ(page.body.at("data-report-status"), "ok") << page.log;
 }
 
 // Without a sensor: a loaded and an unloaded run (t, q*, tau*), the load reported at a flange

@@ -6,6 +6,8 @@
 
 #include <Eigen/Core>
 
+#include "dynid/common/progress.hpp"
+
 #include "dynid/excitation/fourier_trajectory.hpp"
 #include "dynid/model/model.hpp"
 #include "dynid/regressor/parameter_layout.hpp"
@@ -64,6 +66,7 @@ struct ExcitationOptions {
 
   int starts = 4;              ///< multi-start: number of random initial points
   unsigned seed = 20261123;    ///< seed of the random initial points (deterministic runs)
+  ProgressCallback progress;   ///< called after each start (common/progress.hpp); may be empty
   int max_evaluations = 3000;  ///< evaluation budget per start
   double max_time = 10.0;      ///< wall-clock budget of base parameters + all starts [s]; 0 = none
                                ///< (the final fine-grid check gets one more max_time at most)

@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 
+#include "dynid/common/progress.hpp"
 #include "dynid/sim/pid_controller.hpp"
 #include "dynid/sim/plant.hpp"
 #include "dynid/sim/sensors.hpp"
@@ -25,6 +26,7 @@ struct ClosedLoopOptions {
   bool record_truth = false;  ///< also return the true q, dq, ddq and the noise-free torque
   Eigen::VectorXd q0;         ///< initial joint positions; empty = qr(t_0)
   Eigen::VectorXd dq0;        ///< initial joint velocities; empty = dqr(t_0)
+  ProgressCallback progress;  ///< called every 1000 samples (common/progress.hpp); may be empty
 };
 
 /// The logged run: one row per controller sample, t_k = t_0 + k·Ts.
