@@ -15,6 +15,7 @@ void add_commands(CLI::App& app) {
   add_average_command(app);
   add_demo_command(app);
   add_payload_command(app);
+  add_run_command(app);
   check_numeric_flags(app);
 }
 

@@ -39,4 +39,7 @@ void add_average_command(CLI::App& app);
 /// `dynid payload`: a gripped load's parameters from a wrist force/torque sensor (cmd_payload.cpp).
 void add_payload_command(CLI::App& app);
 
+/// `dynid run`: a whole study from a YAML project file (cmd_run.cpp, workflow/project.hpp).
+void add_run_command(CLI::App& app);
+
 }  // namespace dynid::cli
