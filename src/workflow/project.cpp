@@ -67,7 +67,8 @@ std::string resolve(const std::string& value, const fs::path& project_dir) {
   if (value.empty() || fs::path(value).is_absolute()) return value;
   std::error_code ec;
   const fs::path beside = project_dir / value;
-  return fs::exists(beside, ec) ? beside.lexically_normal().string() : value;
+  // Files only: a folder named like a built-in robot must not turn `robot: planar2` into a path.
+  return fs::is_regular_file(beside, ec) ? beside.lexically_normal().string() : value;
 }
 
 // A recorded run given by the user: a path, or {join: [files], columns: [names]} for runs logged
