@@ -30,7 +30,7 @@ const std::vector<StageWiring>& project_stages() {
        {{"json", "validation.json", "validation"}, {"predicted", "predicted.csv", "prediction"}}},
       {"export", {{"robot", "robot"}, {"params", "result"}}, {{"out", "identified.urdf", "urdf"}}},
       {"report",
-       {{"in", "excitation"}, {"in", "result"}, {"in", "validation"}},
+       {{"in", "result"}, {"in", "validation"}, {"in", "excitation"}},
        {{"out", "report.html", "report"}}},
   };
   return kStages;
