@@ -18,6 +18,7 @@ void add_commands(CLI::App& app) {
   add_payload_command(app);
   add_export_command(app);
   add_report_command(app);
+  add_run_command(app);
   check_numeric_flags(app);
 }
 

@@ -55,5 +55,7 @@ Model model_from_result(const Model& model, const std::string& params);
 void add_export_command(CLI::App& app);
 /// `dynid report`: self-contained HTML page with plots of result JSON files (cmd_report.cpp).
 void add_report_command(CLI::App& app);
+/// `dynid run`: a whole study from a YAML project file (cmd_run.cpp, workflow/project.hpp).
+void add_run_command(CLI::App& app);
 
 }  // namespace dynid::cli

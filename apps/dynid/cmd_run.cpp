@@ -1,0 +1,75 @@
+// `dynid run project.yaml`: a whole study from a project file (workflow/project.hpp). The project
+// keys are checked against the flags the commands register here, so there is no second list.
+#include <algorithm>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "dynid/common/error.hpp"
+#include "dynid/workflow/project.hpp"
+
+namespace dynid::cli {
+namespace {
+
+struct RunCliOptions {
+  std::string project, out;
+};
+
+CommandTable command_table() {
+  CommandTable table;
+  table.flags = [](const std::string& command, std::vector<CommandFlag>& flags) {
+    CLI::App app;
+    add_commands(app);
+    const auto subs = app.get_subcommands({});
+    const auto sub = std::find_if(subs.begin(), subs.end(),
+                                  [&](const CLI::App* s) { return s->get_name() == command; });
+    if (sub == subs.end()) return false;
+    for (const CLI::Option* o : (*sub)->get_options()) {
+      for (const std::string& name : o->get_lnames()) {
+        flags.push_back({name, o->get_expected_max() > 0,
+                         o->get_multi_option_policy() == CLI::MultiOptionPolicy::TakeAll});
+      }
+    }
+    return true;
+  };
+  table.run = [](const std::vector<std::string>& args) {
+    CLI::App app{"dynid", "dynid"};
+    app.require_subcommand(1, 1);
+    add_commands(app);
+    std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 parses from the back
+    try {
+      app.parse(reversed);
+    } catch (const CLI::ParseError& e) {
+      throw UsageError(std::string(e.what()) + " (project keys are the flags without --)");
+    }
+  };
+  return table;
+}
+
+void run(const RunCliOptions& c) {
+  ProjectOptions o;
+  o.project_file = c.project;
+  o.output = c.out;
+  const ProjectResult r =
+      run_project(o, command_table(), [](const std::string& line) { std::cerr << line << '\n'; });
+  std::cout << "study written to " << r.output_dir << " (" << r.commands.size()
+            << " stages; the project file and commands.txt beside the results)\n";
+}
+
+}  // namespace
+
+void add_run_command(CLI::App& app) {
+  auto c = std::make_shared<RunCliOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "run",
+      "Run a whole study from a YAML project file: each stage (model, excite, simulate or data, "
+      "identify, validate) is a mapping of that command's flags without --; everything is "
+      "written into the output folder with the project file copied beside it (docs/cli.md)");
+  cmd->add_option("project", c->project, "Project YAML file")->required();
+  cmd->add_option("--out,-o", c->out, "Output folder instead of the project's output: key");
+  cmd->callback([c] { run(*c); });
+}
+
+}  // namespace dynid::cli
