@@ -163,15 +163,7 @@ ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& option
     lp.cutoff_hz = cutoff;
     lp.sample_rate_hz = rate;
     lp.ripple_db = options.ripple_db;
-    filter = design_lowpass(lp);
-    // An even-order Chebyshev I design sits at the bottom of its ripple at DC (gain 1/sqrt(1+ε²));
-    // identification needs unit DC gain, or every signal would be scaled (q enters non-linearly).
-    double dc = 1.0;
-    for (int k = 0; k < filter.sections(); ++k) {
-      const auto row = filter.sos.row(k);
-      dc *= (row(0) + row(1) + row(2)) / (row(3) + row(4) + row(5));
-    }
-    filter.sos.row(0).head<3>() /= dc;
+    filter = design_lowpass_unit_dc(lp);
     // Noise of the velocity as processed: from the position's noise floor through filter and
     // central differences, or from the given velocity's floor through the filter.
     const bool given_dq = r.dq.size() != 0;

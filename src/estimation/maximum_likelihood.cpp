@@ -294,13 +294,7 @@ MeasurementNoise processed_noise(const SensorNoise& given, const SignalOptions& 
     lp.cutoff_hz = processed.cutoff_hz;
     lp.sample_rate_hz = rate;
     lp.ripple_db = signal.ripple_db;
-    filter = design_lowpass(lp);
-    double dc = 1.0;
-    for (int k = 0; k < filter.sections(); ++k) {
-      const auto row = filter.sos.row(k);
-      dc *= (row(0) + row(1) + row(2)) / (row(3) + row(4) + row(5));
-    }
-    filter.sos.row(0).head<3>() /= dc;
+    filter = design_lowpass_unit_dc(lp);
   }
   const SosFilter* f = filtered ? &filter : nullptr;
   const double g0 = white_noise_gain(f, 0, rate), g1 = white_noise_gain(f, 1, rate),

@@ -115,4 +115,15 @@ std::complex<double> frequency_response(const SosFilter& filter, double frequenc
   return h;
 }
 
+SosFilter design_lowpass_unit_dc(const LowpassOptions& options) {
+  SosFilter filter = design_lowpass(options);
+  double dc = 1.0;
+  for (int k = 0; k < filter.sections(); ++k) {
+    const auto row = filter.sos.row(k);
+    dc *= (row(0) + row(1) + row(2)) / (row(3) + row(4) + row(5));
+  }
+  filter.sos.row(0).head<3>() /= dc;
+  return filter;
+}
+
 }  // namespace dynid

@@ -142,6 +142,27 @@ TEST(Sosfilt, CausalPhaseMatchesResponseAndColumnsAreIndependent) {
   EXPECT_TRUE(yy.col(1).isApprox(filtfilt(f, Eigen::VectorXd(x.col(1))), 1e-15));
 }
 
+// An even-order Chebyshev I design sits at the bottom of its ripple at DC; the identification
+// filter is the same design rescaled to unit DC gain: a constant passes unchanged through the
+// causal filter (independent of the section algebra), and the shape is the design's at every f.
+TEST(LowpassUnitDc, EvenChebyshevPassesAConstantUnchangedAndKeepsItsShape) {
+  LowpassOptions o;
+  o.family = LowpassFamily::kChebyshev1;
+  o.order = 8;
+  o.cutoff_hz = 80;
+  o.sample_rate_hz = 1000;
+  o.ripple_db = 1.0;
+  const SosFilter plain = design_lowpass(o), unit = design_lowpass_unit_dc(o);
+  const double ripple_dc = 1.0 / std::sqrt(std::pow(10.0, 0.1 * o.ripple_db));
+  EXPECT_NEAR(std::abs(frequency_response(plain, 0.0, 1000.0)), ripple_dc, 1e-9);
+  const Eigen::MatrixXd y = sosfilt(unit, Eigen::MatrixXd::Constant(20000, 1, 2.5));
+  EXPECT_NEAR(y(19999, 0), 2.5, 1e-9);
+  for (const double f : {10.0, 60.0, 120.0}) {
+    EXPECT_NEAR(std::abs(frequency_response(unit, f, 1000.0)),
+                std::abs(frequency_response(plain, f, 1000.0)) / ripple_dc, 1e-9);
+  }
+}
+
 // Steady-state initial conditions: a constant signal passes unchanged, at every sample.
 TEST(Filtfilt, ConstantAndStepSteadyState) {
   LowpassOptions o;

@@ -45,6 +45,12 @@ struct SosFilter {
 /// Throws dynid::Error for order < 1, sample rate ≤ 0, cut-off ≤ 0 or ≥ Nyquist, ripple ≤ 0.
 SosFilter design_lowpass(const LowpassOptions& options);
 
+/// design_lowpass rescaled to a DC gain of exactly 1 (the first section's numerator divided by the
+/// product of the sections' DC gains): identification filters every signal, and an even-order
+/// Chebyshev I design would scale them all by 1/sqrt(1+ε²) (q enters the model non-linearly).
+/// Identity: H(1) = 1. Throws as design_lowpass.
+SosFilter design_lowpass_unit_dc(const LowpassOptions& options);
+
 /// Complex frequency response H(e^{j·2π·f/fs}) of the filter at frequency f [Hz] for sample rate
 /// fs [Hz] (evaluates the sections directly; no allocation).
 std::complex<double> frequency_response(const SosFilter& filter, double frequency_hz,
