@@ -12,6 +12,7 @@
 #include <nlopt.hpp>
 
 #include "dynid/common/error.hpp"
+#include "dynid/dynamics/kinematics.hpp"
 #include "dynid/dynamics/rnea.hpp"
 #include "dynid/dynamics/workspace.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
@@ -304,7 +305,9 @@ class Evaluator {
       for (int c2 = 0; c2 < p_; ++c2) YbT_.row(c2) = Y_.col(pb_.base[c2]).transpose();
       A_.selfadjointView<Eigen::Lower>().rankUpdate(YbT_);
       if (keep_) Wb.middleRows(static_cast<Eigen::Index>(s) * n, n) = YbT_.transpose();
-      if (has_torque_ || has_workspace_) rnea(model_, ws_, q_, dq_, ddq_, tau_);
+      if (has_torque_) rnea(model_, ws_, q_, dq_, ddq_, tau_);
+      // The joint origins in the world frame (rnea and the regressor compute local poses only).
+      if (has_workspace_) forward_kinematics(model_, ws_, q_);
       const double t = s / (samples_ * pb_.f0);
       for (size_t gi = 0; gi < groups_.size(); ++gi) {
         const Group& gr = groups_[gi];

@@ -14,8 +14,10 @@ namespace dynid {
 struct LinkState {
   Eigen::Matrix3d R_PJ;  ///< orientation of frame j in its parent frame at the current q
   Eigen::Vector3d p_PJ;  ///< origin of frame j in its parent frame at the current q [m]
-  Eigen::Matrix3d R_WJ;  ///< orientation of frame j in the base (world) frame
-  Eigen::Vector3d p_WJ;  ///< origin of frame j in the base frame [m]
+  /// Orientation of frame j in the base (world) frame. R_WJ and p_WJ are set by
+  /// forward_kinematics only: rnea, the mass matrix and the regressors leave them as they were.
+  Eigen::Matrix3d R_WJ;
+  Eigen::Vector3d p_WJ;  ///< origin of frame j in the base frame [m] (see R_WJ)
   Eigen::Vector3d w;     ///< angular velocity of link j [rad/s]
   Eigen::Vector3d v;     ///< linear velocity of origin j [m/s]
   Eigen::Vector3d dw;    ///< angular acceleration [rad/s²]
