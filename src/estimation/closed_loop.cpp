@@ -90,7 +90,7 @@ Eigen::MatrixXd periodic_derivative(const Eigen::MatrixXd& x, int p, double ts, 
 // (or its derivative). Whole periods make the discrete basis orthogonal for H < period/2.
 class LineProjector : public SignalProjector {
  public:
-  LineProjector(Eigen::Index len, int period, int harmonics, double ts) : len_(len), ts_(ts) {
+  LineProjector(Eigen::Index len, int period, int harmonics, double ts) : len_(len) {
     basis_.resize(len, 2 * harmonics + 1);
     d1_.resize(len, 2 * harmonics + 1);
     d2_.resize(len, 2 * harmonics + 1);
@@ -129,7 +129,6 @@ class LineProjector : public SignalProjector {
 
  private:
   Eigen::Index len_;
-  double ts_;
   Eigen::MatrixXd basis_, d1_, d2_;
   Eigen::LDLT<Eigen::MatrixXd> gram_;
 };
