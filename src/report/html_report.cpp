@@ -208,8 +208,8 @@ void add_prediction_plots(const Json& plot, const std::vector<std::string>& name
       section["charts"].push_back(
           line_chart(name + ": measured and predicted torque", "t [s]", "torque [N·m]",
                      {series("measured", t, m), series("predicted", t, p)}));
-      section["charts"].push_back(
-          line_chart(name + ": residual", "t [s]", "τ − τ̂ [N·m]", {series("residual", t, r)}));
+      section["charts"].push_back(line_chart(name + ": residual", "t [s]", "τ − τ̂ [N·m]",
+                                             Json::array({series("residual", t, r)})));
       const Json& h = joint.value("histogram", Json());
       if (h.is_object() && h.value("centers", Json::array()).empty()) {
         add_fact(section, name + ": residual", "identically zero (no histogram)");
@@ -821,13 +821,16 @@ nlohmann::json prediction_plot_json(const Eigen::VectorXd& t, const Eigen::Matri
       const ErrorStatistics st = error_statistics(e);
       const int bins = std::max(3, options.histogram_bins);
       Json centers = Json::array(), density = Json::array(), gaussian = Json::array();
-      if (st.std > 0.0) {
+      if (st.std > 0.0 && std::isfinite(st.std) && std::isfinite(st.mean)) {
         // mean ± 4σ: a Gaussian's mass outside is 6e-5; heavier tails pile into the end bins.
         const double lo = st.mean - 4.0 * st.std, width = 8.0 * st.std / bins;
         std::vector<double> counts(static_cast<size_t>(bins), 0.0);
         for (Eigen::Index i = 0; i < e.size(); ++i) {
-          const int b = static_cast<int>(std::floor((e(i) - lo) / width));
-          counts[static_cast<size_t>(std::clamp(b, 0, bins - 1))] += 1.0;
+          // Clamped as a double: a residual far outside (a huge torque sample) must not
+          // overflow the int conversion; one that is not a number is not counted.
+          const double x = std::floor((e(i) - lo) / width);
+          if (std::isnan(x)) continue;
+          counts[static_cast<size_t>(std::clamp(x, 0.0, bins - 1.0))] += 1.0;
         }
         for (int b = 0; b < bins; ++b) {
           const double c = lo + (b + 0.5) * width;
