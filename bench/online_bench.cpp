@@ -43,7 +43,8 @@ void BM_OnlineUpdate(benchmark::State& st, const std::string& name) {
     k = (k + 1) % m;
   }
   st.counters["base_parameters"] = static_cast<double>(base.rank);
-  st.counters["samples_per_s"] = benchmark::Counter(1.0, benchmark::Counter::kIsIterationInvariantRate);
+  st.counters["samples_per_s"] =
+      benchmark::Counter(1.0, benchmark::Counter::kIsIterationInvariantRate);
 }
 
 }  // namespace
