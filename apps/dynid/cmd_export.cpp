@@ -8,6 +8,7 @@
 #include "dynid/io/atomic_file.hpp"
 #include "dynid/io/urdf_export.hpp"
 #include "dynid/model/robots.hpp"
+#include "flag_checks.hpp"
 
 namespace dynid::cli {
 namespace {
@@ -28,11 +29,8 @@ void run_export(const ExportOptions& o) {
   }
   const Model model = load_robot(o.robot);
   const ConsistentParameterFile file = read_consistent_parameters(o.params);
-  if (!file.robot.empty() && file.robot != model.name) {
-    throw Error("'" + o.params + "' was identified on robot '" + file.robot +
-                "' but --robot gives '" + model.name +
-                "'; export with the robot the parameters were identified on");
-  }
+  require_same_robot(file.robot, model.name, "'" + o.params + "'",
+                     "export with the robot the parameters were identified on");
   if (!file.joints.empty()) {
     bool same = static_cast<int>(file.joints.size()) == model.dof();
     for (int j = 0; same && j < model.dof(); ++j) same = file.joints[j] == model.joints[j].name;

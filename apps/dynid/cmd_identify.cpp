@@ -29,6 +29,7 @@
 #include "dynid/report/identification_report.hpp"
 #include "dynid/sim/pid_gains.hpp"
 #include "dynid/sim/simulate_reference.hpp"
+#include "flag_checks.hpp"
 #include "result_options.hpp"
 
 namespace dynid::cli {
@@ -380,10 +381,7 @@ void refuse_undetermined(const IdentifiedResultFile& f, const std::string& path,
 Model compensation_model(const Model& model, const std::string& params) {
   if (params.empty()) return model;
   const IdentifiedResultFile f = read_identification_result(params);
-  if (!f.robot.empty() && f.robot != model.name) {
-    throw Error("'" + params + "' was identified on robot '" + f.robot + "' but --robot gives '" +
-                model.name + "'; give a result of this robot");
-  }
+  require_same_robot(f.robot, model.name, "'" + params + "'", "give a result of this robot");
   refuse_undetermined(f, params, "compensate a friction experiment with it");
   IdentifyCliOptions o;
   const FileOptions file_options{f.options, params};
@@ -543,10 +541,8 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     progress.update((steps - 1.0) / steps, "filtering and estimating");
     for (const auto& f : o.friction_known) {
       const IdentifiedResultFile known = read_identification_result(f);
-      if (!known.robot.empty() && known.robot != model.name) {
-        throw Error("--friction-known '" + f + "' was identified on robot '" + known.robot +
-                    "' but --robot gives '" + model.name + "'; give a result of this robot");
-      }
+      require_same_robot(known.robot, model.name, "--friction-known '" + f + "'",
+                         "give a result of this robot");
       add_known_friction(options.known_friction, model, known.names, known.values, f);
     }
     if (!o.noise.empty()) options.noise = read_sensor_noise(o.noise, model);
@@ -694,11 +690,8 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
   }
   const Model model = load_robot(v.robot);
   const IdentifiedResultFile identified = read_identification_result(v.params);
-  if (!identified.robot.empty() && identified.robot != model.name) {
-    throw Error("'" + v.params + "' was identified on robot '" + identified.robot +
-                "' but --robot gives '" + model.name +
-                "'; validate with the robot the parameters were identified on");
-  }
+  require_same_robot(identified.robot, model.name, "'" + v.params + "'",
+                     "validate with the robot the parameters were identified on");
   const std::vector<std::string>& names = identified.names;
   const Eigen::VectorXd& values = identified.values;
   RunFileReport read;

@@ -178,11 +178,8 @@ void run_payload_from_result(const PayloadCliOptions& cli, LoadIdentificationOpt
                              const Model& model, int link, const LoadFrame& frame,
                              RunFileOptions file) {
   const IdentifiedResultFile identified = read_identification_result(cli.reference);
-  if (!identified.robot.empty() && identified.robot != model.name) {
-    throw Error("--reference '" + cli.reference + "' was identified on robot '" + identified.robot +
-                "' but --robot gives '" + model.name +
-                "'; give a result of the robot that carries the load");
-  }
+  require_same_robot(identified.robot, model.name, "--reference '" + cli.reference + "'",
+                     "give a result of the robot that carries the load");
   RunFileReport read;
   const IdentifyOptions identify =
       options_from_identification_result(identified, cli.reference, model.dof(), {}, file, read);

@@ -123,4 +123,11 @@ std::vector<double> flag_numbers(const std::string& text, std::size_t count, con
   return v;
 }
 
+void require_same_robot(const std::string& file_robot, const std::string& robot,
+                        const std::string& what, const std::string& fix) {
+  if (file_robot.empty() || file_robot == robot) return;
+  throw Error(what + " was identified on robot '" + file_robot + "' but --robot gives '" + robot +
+              "'; " + fix);
+}
+
 }  // namespace dynid::cli

@@ -16,6 +16,11 @@ namespace dynid::cli {
 /// all subcommands are registered.
 void check_numeric_flags(CLI::App& app);
 
+/// A result file must come from the robot it is used with: Error "WHAT was identified on robot
+/// 'FILE_ROBOT' but --robot gives 'ROBOT'; FIX" unless file_robot is empty (older files) or equal.
+void require_same_robot(const std::string& file_robot, const std::string& robot,
+                        const std::string& what, const std::string& fix);
+
 /// "a b c ..." (a flag's text, e.g. --sensor-pose "x y z roll pitch yaw") → exactly `count` finite
 /// numbers. Throws UsageError naming the flag, the bad word or the count, and `meaning` (what to
 /// give instead).
