@@ -375,8 +375,13 @@ BlockEstimate estimate_as_given(const EquationBlock& block, const BlockEstimatio
     c << "white-noise sigma^2 (W^T W)^-1 (no residual degrees of freedom for a sandwich)";
   } else {
     c << "Newey-West (HAC) sandwich over samples, Bartlett window of " << h.bandwidth
-      << " samples (" << (options.hac_bandwidth >= 0 ? "given" : "Andrews AR(1) rule, b >= 0.02")
-      << "), ci_* = value -+ " << h.critical_value << " std (fixed-b critical value at b = " << h.b
+      << " samples (";
+    if (options.hac_bandwidth >= 0) {
+      c << "given";
+    } else {
+      c << "Andrews AR(1) rule, b >= " << hac.min_bandwidth_fraction;
+    }
+    c << "), ci_* = value -+ " << h.critical_value << " std (fixed-b critical value at b = " << h.b
       << ", Kiefer-Vogelsang 2005): std and ci_* allow for correlated residuals "
          "(filtering, unmodelled dynamics); std_white assumes white residuals and is "
       << h.median_ratio << "x smaller (median)";
