@@ -89,9 +89,11 @@ struct StreamSetup {
   const ParameterLayout* layout = nullptr;
   const BaseParameters* base = nullptr;
   std::string path;
-  std::vector<std::vector<Eigen::Index>> active;         // base columns per joint
-  std::vector<std::vector<Eigen::Index>> active_full;    // the same as regressor columns
-  std::vector<std::vector<Eigen::Index>> inactive_full;  // the others, checked to be zero
+  std::vector<std::vector<Eigen::Index>> active;  // base columns per joint
+  // The same as offsets into a worker's n-row regressor storage (regressor column·n + joint), and
+  // the other base columns, checked to be zero: the per-sample gather and check read Y with one
+  // index and no multiplication.
+  std::vector<std::vector<Eigen::Index>> active_offset, inactive_offset;
   std::vector<Eigen::Index> cq, cdq, cddq, ctau;
   Eigen::VectorXd threshold;
 };
@@ -108,12 +110,13 @@ void process_block(const StreamSetup& s, Worker& w, const Eigen::MatrixXd& block
       w.ddq[j] = block(k, s.cddq[j]);
     }
     torque_regressor(model, w.ws, *s.layout, w.q, w.dq, w.ddq, w.Y);
+    const double* y = w.Y.data();
     for (int j = 0; j < n; ++j) {
       if (std::abs(w.dq[j]) < s.threshold[j]) continue;
-      const auto& act = s.active_full[j];
-      for (std::size_t c = 0; c < act.size(); ++c) w.w[c] = w.Y(j, act[c]);
-      for (Eigen::Index c : s.inactive_full[j]) {
-        if (w.Y(j, c) != 0.0) {
+      const auto& act = s.active_offset[j];
+      for (std::size_t c = 0; c < act.size(); ++c) w.w[static_cast<Eigen::Index>(c)] = y[act[c]];
+      for (Eigen::Index off : s.inactive_offset[j]) {
+        if (y[off] != 0.0) {
           throw Error("internal: the regressor of joint " + model.joints[j].name +
                       " is non-zero in a column probed as structurally zero (data row " +
                       std::to_string(first_row + k + 1) + "); run without --stream and report it");
@@ -309,12 +312,12 @@ IdentificationResult identify_stream(const Model& model, const std::string& path
   s.threshold = given_zero_velocity(options.signal.zero_velocity, n);
   if (s.threshold.size() == 0) s.threshold = Eigen::VectorXd::Zero(n);  // no automatic rule here
   s.active = joint_base_columns(model, options.layout, result.base);
-  s.active_full.resize(n);
-  s.inactive_full.resize(n);
+  s.active_offset.resize(n);
+  s.inactive_offset.resize(n);
   for (int j = 0; j < n; ++j) {
     for (Eigen::Index c = 0, a = 0; c < rank; ++c) {
       const bool active = a < static_cast<Eigen::Index>(s.active[j].size()) && s.active[j][a] == c;
-      (active ? s.active_full[j] : s.inactive_full[j]).push_back(result.base.base[c]);
+      (active ? s.active_offset[j] : s.inactive_offset[j]).push_back(result.base.base[c] * n + j);
       a += active;
     }
   }
