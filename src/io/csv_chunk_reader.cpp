@@ -24,7 +24,7 @@ struct CsvChunkReader::Impl {
   long line = 0;
   Eigen::Index rows = 0;
   std::vector<std::string> columns;
-  Eigen::MatrixXd scratch;  // full chunk_rows block, reused
+  CsvTextChunk chunk;  // next()'s text, reused
 
   ~Impl() {
     if (file != nullptr) std::fclose(file);
@@ -112,7 +112,6 @@ CsvChunkReader::CsvChunkReader(const std::string& path, const CsvChunkOptions& o
   while (impl_->next_line(b, e, terminated)) {
     if (csv_detail::is_skippable(b, e)) continue;
     impl_->columns = csv_detail::parse_header(b, e, path, impl_->line);
-    impl_->scratch.resize(options.chunk_rows, static_cast<Eigen::Index>(impl_->columns.size()));
     return;
   }
   csv_detail::throw_empty(path);
@@ -129,29 +128,59 @@ Eigen::Index CsvChunkReader::rows_read() const {
 }
 
 bool CsvChunkReader::next(Eigen::MatrixXd& block) {
+  if (!next_text(impl_->chunk)) {
+    block.resize(0, static_cast<Eigen::Index>(impl_->columns.size()));
+    return false;
+  }
+  parse_text(impl_->chunk, block);
+  return true;
+}
+
+bool CsvChunkReader::next_text(CsvTextChunk& chunk) {
   Impl& s = *impl_;
-  const Eigen::Index capacity = s.options.chunk_rows;
-  const auto n = static_cast<Eigen::Index>(s.columns.size());
-  Eigen::Index count = 0;
+  chunk.text.clear();
+  chunk.ends.clear();
+  chunk.lines.clear();
+  chunk.first_row = s.rows;
+  chunk.unterminated = false;
   const char* b = nullptr;
   const char* e = nullptr;
   bool terminated = true;
-  // Parse straight into `block` when it already has the full chunk shape (the common case).
-  const bool direct = block.rows() == capacity && block.cols() == n;
-  Eigen::MatrixXd& target = direct ? block : s.scratch;
-  while (count < capacity && s.next_line(b, e, terminated)) {
-    if (csv_detail::is_skippable(b, e)) continue;
-    csv_detail::parse_row(b, e, s.columns, target.data() + count, capacity, s.source, s.line,
-                          static_cast<long>(s.rows + count) + 1, !terminated);
-    ++count;
+  try {
+    while (chunk.rows() < s.options.chunk_rows && s.next_line(b, e, terminated)) {
+      if (csv_detail::is_skippable(b, e)) continue;
+      chunk.text.insert(chunk.text.end(), b, e);
+      chunk.ends.push_back(chunk.text.size());
+      chunk.lines.push_back(s.line);
+      chunk.unterminated = !terminated;
+    }
+  } catch (const Error&) {
+    // The first error in file order wins, as in a row-by-row read: a malformed row cut before
+    // the failing read (or over-long line) is reported instead.
+    Eigen::MatrixXd rows_before;
+    parse_text(chunk, rows_before);
+    throw;
   }
-  s.rows += count;
-  if (count == 0 && s.rows == 0) {
+  s.rows += chunk.rows();
+  if (chunk.rows() == 0 && s.rows == 0) {
     throw Error(s.source + ": header but no data rows; add one line of numbers per sample");
   }
-  if (direct && count == capacity) return true;
-  block = target.topRows(count).eval();  // eval: target may alias block
-  return count > 0;
+  return chunk.rows() > 0;
+}
+
+void CsvChunkReader::parse_text(const CsvTextChunk& chunk, Eigen::MatrixXd& block) const {
+  const Impl& s = *impl_;
+  const Eigen::Index rows = chunk.rows();
+  block.resize(rows, static_cast<Eigen::Index>(s.columns.size()));
+  const char* text = chunk.text.data();
+  for (Eigen::Index k = 0; k < rows; ++k) {
+    const std::size_t begin = k == 0 ? 0 : chunk.ends[static_cast<std::size_t>(k - 1)];
+    const std::size_t end = chunk.ends[static_cast<std::size_t>(k)];
+    csv_detail::parse_row(text + begin, text + end, s.columns, block.data() + k, rows, s.source,
+                          chunk.lines[static_cast<std::size_t>(k)],
+                          static_cast<long>(chunk.first_row + k) + 1,
+                          chunk.unterminated && k + 1 == rows);
+  }
 }
 
 void for_each_csv_chunk(

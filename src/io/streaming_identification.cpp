@@ -22,7 +22,7 @@ namespace {
 // sign so that one-sided (asymmetric Coulomb) columns are seen as well.
 constexpr int kSparsityProbes = 8;
 constexpr unsigned kSparsitySeed = 20261123;
-// Upper bound on worker threads (more do not help: the reader is serial).
+// Upper bound on worker threads (each holds kQueueDepth chunks of text in memory).
 constexpr int kMaxThreads = 8;
 // Chunks queued per worker: enough to keep a worker busy while the reader serves the others.
 constexpr std::size_t kQueueDepth = 3;
@@ -72,11 +72,11 @@ struct Worker {
   StreamingLeastSquares lsq;
   Eigen::MatrixXd Y;
   Eigen::VectorXd q, dq, ddq, w;
-  // Ring of chunks handed over by the reader: [head, tail) are filled, in order.
+  Eigen::MatrixXd block;  // the chunk being processed, parsed from its text by this worker
+  // Ring of chunks handed over by the reader, unparsed: [head, tail) are filled, in order.
   std::mutex mutex;
   std::condition_variable cv;
-  std::array<Eigen::MatrixXd, kQueueDepth> blocks;
-  std::array<Eigen::Index, kQueueDepth> first_rows{};
+  std::array<CsvTextChunk, kQueueDepth> chunks;
   std::size_t head = 0, tail = 0;
   bool done = false;
   std::exception_ptr error;
@@ -89,9 +89,11 @@ struct StreamSetup {
   const ParameterLayout* layout = nullptr;
   const BaseParameters* base = nullptr;
   std::string path;
-  std::vector<std::vector<Eigen::Index>> active;         // base columns per joint
-  std::vector<std::vector<Eigen::Index>> active_full;    // the same as regressor columns
-  std::vector<std::vector<Eigen::Index>> inactive_full;  // the others, checked to be zero
+  std::vector<std::vector<Eigen::Index>> active;  // base columns per joint
+  // The same as offsets into a worker's n-row regressor storage (regressor column·n + joint), and
+  // the other base columns, checked to be zero: the per-sample gather and check read Y with one
+  // index and no multiplication.
+  std::vector<std::vector<Eigen::Index>> active_offset, inactive_offset;
   std::vector<Eigen::Index> cq, cdq, cddq, ctau;
   Eigen::VectorXd threshold;
 };
@@ -108,12 +110,13 @@ void process_block(const StreamSetup& s, Worker& w, const Eigen::MatrixXd& block
       w.ddq[j] = block(k, s.cddq[j]);
     }
     torque_regressor(model, w.ws, *s.layout, w.q, w.dq, w.ddq, w.Y);
+    const double* y = w.Y.data();
     for (int j = 0; j < n; ++j) {
       if (std::abs(w.dq[j]) < s.threshold[j]) continue;
-      const auto& act = s.active_full[j];
-      for (std::size_t c = 0; c < act.size(); ++c) w.w[c] = w.Y(j, act[c]);
-      for (Eigen::Index c : s.inactive_full[j]) {
-        if (w.Y(j, c) != 0.0) {
+      const auto& act = s.active_offset[j];
+      for (std::size_t c = 0; c < act.size(); ++c) w.w[static_cast<Eigen::Index>(c)] = y[act[c]];
+      for (Eigen::Index off : s.inactive_offset[j]) {
+        if (y[off] != 0.0) {
           throw Error("internal: the regressor of joint " + model.joints[j].name +
                       " is non-zero in a column probed as structurally zero (data row " +
                       std::to_string(first_row + k + 1) + "); run without --stream and report it");
@@ -124,7 +127,9 @@ void process_block(const StreamSetup& s, Worker& w, const Eigen::MatrixXd& block
   }
 }
 
-// Reads the file once and accumulates every chunk; chunk k is processed by worker k mod W.
+// Reads the file once and accumulates every chunk; chunk k is processed by worker k mod W. The
+// reader thread only cuts lines; each worker parses its own chunks, so the parse runs on every
+// core instead of bounding the rate from one thread.
 // Returns the merged accumulator. The first error in file order is rethrown after all threads
 // have stopped, so no thread outlives the call.
 StreamingLeastSquares accumulate(const StreamSetup& s, const StreamingOptions& lsq_options,
@@ -137,28 +142,29 @@ StreamingLeastSquares accumulate(const StreamSetup& s, const StreamingOptions& l
   CsvChunkReader reader(s.path);
   samples = 0;
   if (threads == 1) {
-    Eigen::MatrixXd block;
-    while (reader.next(block)) {
-      process_block(s, *workers[0], block, samples);
-      samples += block.rows();
+    Worker& w = *workers[0];
+    while (reader.next_text(w.chunks[0])) {
+      reader.parse_text(w.chunks[0], w.block);
+      process_block(s, w, w.block, samples);
+      samples += w.block.rows();
     }
-    return std::move(workers[0]->lsq);
+    return std::move(w.lsq);
   }
 
   std::vector<std::thread> pool;
   for (int t = 0; t < threads; ++t) {
-    pool.emplace_back([&s, &w = *workers[t], t, threads] {
+    pool.emplace_back([&s, &reader, &w = *workers[t], t, threads] {
       for (Eigen::Index index = t;; index += threads) {
         std::unique_lock<std::mutex> lock(w.mutex);
         w.cv.wait(lock, [&w] { return w.head != w.tail || w.done; });
         if (w.head == w.tail) return;
-        Eigen::MatrixXd& block = w.blocks[w.head % kQueueDepth];
-        const Eigen::Index first_row = w.first_rows[w.head % kQueueDepth];
+        const CsvTextChunk& chunk = w.chunks[w.head % kQueueDepth];
         const bool failed = static_cast<bool>(w.error);
         lock.unlock();  // the reader only touches other slots while this one is in use
         if (!failed) {
           try {
-            process_block(s, w, block, first_row);
+            reader.parse_text(chunk, w.block);
+            process_block(s, w, w.block, chunk.first_row);
           } catch (...) {
             lock.lock();
             w.error = std::current_exception();
@@ -176,15 +182,14 @@ StreamingLeastSquares accumulate(const StreamSetup& s, const StreamingOptions& l
   std::exception_ptr reader_error;
   Eigen::Index index = 0;
   try {
-    Eigen::MatrixXd block;
-    while (reader.next(block)) {
+    CsvTextChunk chunk;
+    while (reader.next_text(chunk)) {
       Worker& w = *workers[index % threads];
       std::unique_lock<std::mutex> lock(w.mutex);
       w.cv.wait(lock, [&w] { return w.tail - w.head < kQueueDepth; });
       if (w.error) break;
-      const Eigen::Index rows = block.rows();
-      w.blocks[w.tail % kQueueDepth].swap(block);
-      w.first_rows[w.tail % kQueueDepth] = samples;
+      const Eigen::Index rows = chunk.rows();
+      std::swap(w.chunks[w.tail % kQueueDepth], chunk);  // both keep their storage
       ++w.tail;
       lock.unlock();
       w.cv.notify_all();
@@ -307,12 +312,12 @@ IdentificationResult identify_stream(const Model& model, const std::string& path
   s.threshold = given_zero_velocity(options.signal.zero_velocity, n);
   if (s.threshold.size() == 0) s.threshold = Eigen::VectorXd::Zero(n);  // no automatic rule here
   s.active = joint_base_columns(model, options.layout, result.base);
-  s.active_full.resize(n);
-  s.inactive_full.resize(n);
+  s.active_offset.resize(n);
+  s.inactive_offset.resize(n);
   for (int j = 0; j < n; ++j) {
     for (Eigen::Index c = 0, a = 0; c < rank; ++c) {
       const bool active = a < static_cast<Eigen::Index>(s.active[j].size()) && s.active[j][a] == c;
-      (active ? s.active_full[j] : s.inactive_full[j]).push_back(result.base.base[c]);
+      (active ? s.active_offset[j] : s.inactive_offset[j]).push_back(result.base.base[c] * n + j);
       a += active;
     }
   }

@@ -8,6 +8,27 @@
 
 namespace dynid {
 
+namespace {
+
+// One (joint i, link j) block of the regressor: the power pairing of joint i's unit twist
+// (w; v), expressed in frame j, with link j's parameter-linear wrench (seed 1 eq. 28):
+// tau_i += ωᵀn_j + vᵀf_j. The ten entries go to out[0], out[ld], … (a row of Y).
+inline void pair_block(const Eigen::Vector3d& w, const Eigen::Vector3d& v,
+                       const detail::WrenchBlocks& b, double* out, Eigen::Index ld) {
+  // ωᵀL_I, with L_I = [·dω] + [ω×][·ω] kept as its 3×6 matrix.
+  for (int c = 0; c < 6; ++c) {
+    out[c * ld] = w.x() * b.L_I(0, c) + w.y() * b.L_I(1, c) + w.z() * b.L_I(2, c);
+  }
+  // ωᵀ(−[a×]) = (a × ω)ᵀ, plus vᵀK_mc.
+  const Eigen::Vector3d m = b.a.cross(w) + b.K_mc.transpose() * v;
+  out[6 * ld] = m.x();
+  out[7 * ld] = m.y();
+  out[8 * ld] = m.z();
+  out[9 * ld] = v.dot(b.a);
+}
+
+}  // namespace
+
 void torque_regressor(const Model& model, Workspace& ws, const ParameterLayout& layout,
                       const Eigen::Ref<const Eigen::VectorXd>& q,
                       const Eigen::Ref<const Eigen::VectorXd>& dq,
@@ -16,32 +37,32 @@ void torque_regressor(const Model& model, Workspace& ws, const ParameterLayout& 
   assert(Y.rows() == n && Y.cols() == layout.columns(n));
   detail::local_kinematics(model, ws, q, dq, ddq, true);
   Y.setZero();
+  double* const y = Y.data();
+  const Eigen::Index ld = Y.outerStride();
   detail::WrenchBlocks b;
   for (int j = 0; j < n; ++j) {
     const LinkState& s = ws.links[j];
-    // Twists of joint j and its ancestors, carried into frame j: S_i^(j) = X_j·S_i^(parent).
-    auto& twists = ws.twists[j];
-    twists[0] = detail::joint_twist(model.joints[j]);
-    if (model.joints[j].parent >= 0) {
-      const auto& parent_twists = ws.twists[model.joints[j].parent];
-      const Eigen::Matrix3d Rt = s.R_PJ.transpose();
-      for (size_t k = 0; k < parent_twists.size(); ++k) {
-        const auto& Sp = parent_twists[k];
-        twists[k + 1].head<3>().noalias() = Rt * Sp.head<3>();
-        twists[k + 1].tail<3>().noalias() = Rt * (Sp.tail<3>() + Sp.head<3>().cross(s.p_PJ));
-      }
-    }
-    // Link j's wrench about its origin is linear in its parameters (seed 1 eq. 28); joint i's
-    // torque is the power pairing of its twist with that wrench: tau_i += ω_iᵀ n_j + v_iᵀ f_j.
+    const Joint& joint = model.joints[j];
     detail::wrench_blocks(s.w, s.dw, s.a, b);
-    for (size_t k = 0; k < twists.size(); ++k) {
-      const int i = ws.ancestors[j][k];
-      const Eigen::Vector3d w_i = twists[k].head<3>();
-      const Eigen::Vector3d v_i = twists[k].tail<3>();
-      auto row = Y.row(i).segment<kLinkParams>(kLinkParams * j);
-      row.head<6>().noalias() = w_i.transpose() * b.L_I;
-      row.segment<3>(6).noalias() = w_i.transpose() * b.A_skew + v_i.transpose() * b.K_mc;
-      row(9) = v_i.dot(b.a);
+    double* const block = y + ld * kLinkParams * j;  // column 10j of Y
+    // Joint j's own row: its twist is the joint axis in frame j, (axis; 0) or (0; axis).
+    auto& twists = ws.twists[j];
+    twists[0] = detail::joint_twist(joint);
+    pair_block(twists[0].head<3>(), twists[0].tail<3>(), b, block + j, ld);
+    if (joint.parent < 0) continue;
+    // The ancestors' twists, carried from the parent's frame into frame j:
+    // ω' = Rᵀω, v' = Rᵀ(v + ω × p), then paired with link j's wrench at once.
+    const auto& parent_twists = ws.twists[joint.parent];
+    const Eigen::Matrix3d Rt = s.R_PJ.transpose();
+    const std::vector<int>& anc = ws.ancestors[j];
+    for (std::size_t k = 0; k < parent_twists.size(); ++k) {
+      const auto& Sp = parent_twists[k];
+      const Eigen::Vector3d wp = Sp.head<3>();
+      const Eigen::Vector3d w_i = Rt * wp;
+      const Eigen::Vector3d v_i = Rt * (Sp.tail<3>() + wp.cross(s.p_PJ));
+      twists[k + 1].head<3>() = w_i;
+      twists[k + 1].tail<3>() = v_i;
+      pair_block(w_i, v_i, b, block + anc[k + 1], ld);
     }
   }
   const int jc = layout.joint_columns();

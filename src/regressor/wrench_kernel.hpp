@@ -28,10 +28,21 @@ struct WrenchBlocks {
 
 inline void wrench_blocks(const Eigen::Vector3d& w, const Eigen::Vector3d& dw,
                           const Eigen::Vector3d& a, WrenchBlocks& b) {
-  const Eigen::Matrix3d W = skew(w);
-  b.K_mc.noalias() = skew(dw) + W * W;
-  b.L_I.noalias() = dot_matrix(dw) + W * dot_matrix(w);
-  b.A_skew = -skew(a);
+  // Written out entry by entry: Eigen's 3×3 and 3×3·3×6 products of the skew and dot matrices
+  // cost ≈ 70 ns per link, more than all the rest of a link's regressor columns.
+  const double x = w.x(), y = w.y(), z = w.z();
+  const double xx = x * x, yy = y * y, zz = z * z, xy = x * y, xz = x * z, yz = y * z;
+  // K_mc = [dω×] + [ω×]² with [ω×]² = ωωᵀ − |ω|²·1.
+  b.K_mc << -yy - zz, xy - dw.z(), xz + dw.y(),  //
+      xy + dw.z(), -xx - zz, yz - dw.x(),        //
+      xz - dw.y(), yz + dw.x(), -xx - yy;
+  // L_I = [·dω] + [ω×][·ω].
+  b.L_I << dw.x(), dw.y() - xz, dw.z() + xy, -yz, yy - zz, yz,  //
+      xz, dw.x() + yz, zz - xx, dw.y(), dw.z() - xy, -xz,       //
+      -xy, xx - yy, dw.x() - yz, xy, dw.y() + xz, dw.z();
+  b.A_skew << 0.0, a.z(), -a.y(),  //
+      -a.z(), 0.0, a.x(),          //
+      a.y(), -a.x(), 0.0;
   b.a = a;
 }
 

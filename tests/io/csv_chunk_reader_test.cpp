@@ -1,6 +1,7 @@
 #include "dynid/io/csv_chunk_reader.hpp"
 
 #include <random>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -122,6 +123,55 @@ TEST(CsvChunkReader, LineEndBeyondTheFirstBufferIsTheOneReadCsvSees) {
       EXPECT_EQ(all, table.data) << "buffer " << bytes << " bytes, eol " << eol.size();
     }
   }
+}
+
+// Issue 16: the streaming identification cuts chunks on the reader thread and parses them on
+// the workers. Oracle: read_csv of the same file; the chunks are parsed on other threads, out of
+// order, and must give the same rows, row numbers and first error as next().
+TEST(CsvChunkReader, TextChunksParsedOnOtherThreadsEqualTheWholeFile) {
+  TempDir dir;
+  std::mt19937 rng(16);
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd data(700, 4);
+  for (Eigen::Index i = 0; i < data.size(); ++i) data.data()[i] = normal(rng);
+  std::string text = format_csv({"t", "q1", "dq1", "tau1"}, data);
+  text.insert(text.find('\n', 3000) + 1, "# mid comment\r\n\n");
+  text.pop_back();  // the last line has no newline
+  const std::string path = dir.write("chunks.csv", text);
+  const CsvTable whole = read_csv(path);
+  ASSERT_EQ(whole.data, data);
+  CsvChunkReader reader(path, {64, 97});
+  std::vector<CsvTextChunk> chunks;
+  CsvTextChunk chunk;
+  while (reader.next_text(chunk)) chunks.push_back(chunk);
+  ASSERT_EQ(chunks.size(), 11u);  // 10 × 64 + 60
+  std::vector<Eigen::MatrixXd> blocks(chunks.size());
+  std::vector<std::thread> threads;
+  for (std::size_t c = chunks.size(); c-- > 0;) {  // last chunk first
+    threads.emplace_back([&, c] { reader.parse_text(chunks[c], blocks[c]); });
+  }
+  for (auto& t : threads) t.join();
+  Eigen::Index row = 0;
+  for (std::size_t c = 0; c < chunks.size(); ++c) {
+    EXPECT_EQ(chunks[c].first_row, row);
+    ASSERT_EQ(blocks[c], whole.data.middleRows(row, blocks[c].rows())) << "chunk " << c;
+    row += blocks[c].rows();
+  }
+  EXPECT_EQ(row, 700);
+  EXPECT_TRUE(chunks.back().unterminated);
+  // A malformed row cut before an over-long line of the same chunk is the error reported, as a
+  // row-by-row read finds it first; on its own chunk, the bad field names its file line.
+  const std::string bad = dir.write(
+      "order.csv", "a,b\n1,2\n3,x\n4,5\n" + std::string(kMaxCsvLineBytes + 10, '7') + "\n");
+  CsvChunkReader first(bad, {100, 1 << 20});
+  EXPECT_HAS(error_of([&] { first.next_text(chunk); }), "order.csv:3: column 'b' (field 2)");
+  CsvChunkReader alone(bad, {1, 1 << 20});
+  ASSERT_TRUE(alone.next_text(chunk));
+  ASSERT_TRUE(alone.next_text(chunk));
+  Eigen::MatrixXd block;
+  EXPECT_HAS(error_of([&] { alone.parse_text(chunk, block); }), "order.csv:3: column 'b'");
+  EXPECT_TRUE(alone.next_text(chunk));
+  EXPECT_HAS(error_of([&] { alone.next_text(chunk); }), "order.csv:5: line is longer than");
 }
 
 }  // namespace

@@ -91,6 +91,26 @@ TEST(TorqueRegressor, BuiltInRobotsMatchRnea) {
   }
 }
 
+// The regressor writes through Y's storage with its outer stride: rows k·n … k·n+n−1 of a stacked
+// regressor (as the estimators fill it) must equal the same call on an n-row matrix, and the
+// rows around it must stay untouched.
+TEST(TorqueRegressor, WritesIntoARowBlockOfAStackedRegressor) {
+  const Model model = load_robot("iiwa14");
+  const int n = model.dof();
+  Workspace ws(model);
+  const ParameterLayout layout = ParameterLayout::full();
+  std::mt19937 rng(29);
+  const Eigen::VectorXd q = random_vector(n, rng, 3.0), dq = random_vector(n, rng, 2.0),
+                        ddq = random_vector(n, rng, 5.0);
+  Eigen::MatrixXd alone(n, layout.columns(n));
+  torque_regressor(model, ws, layout, q, dq, ddq, alone);
+  Eigen::MatrixXd stacked = Eigen::MatrixXd::Constant(3 * n, layout.columns(n), 7.0);
+  torque_regressor(model, ws, layout, q, dq, ddq, stacked.middleRows(n, n));
+  EXPECT_EQ(stacked.middleRows(n, n), alone);
+  EXPECT_TRUE((stacked.topRows(n).array() == 7.0).all());
+  EXPECT_TRUE((stacked.bottomRows(n).array() == 7.0).all());
+}
+
 TEST(TorqueRegressor, AsymmetricFrictionColumnsFollowSeed2Eq2) {
   Model model = random_tree(4, 40, true);
   Workspace ws(model);

@@ -16,6 +16,19 @@ struct CsvChunkOptions {
   std::size_t buffer_bytes = 1 << 20;  ///< file read size; grows only if one line is longer
 };
 
+/// The unparsed text of up to chunk_rows data lines of a CSV file (comments and blank lines
+/// dropped), cut by CsvChunkReader::next_text so that another thread can parse it with
+/// CsvChunkReader::parse_text: splitting lines is cheap, parsing numbers is not.
+struct CsvTextChunk {
+  std::vector<char> text;         ///< the data lines back to back, without their terminators
+  std::vector<std::size_t> ends;  ///< ends[k]: end of data line k in text (starts at ends[k−1], 0)
+  std::vector<long> lines;        ///< 1-based file line of data line k (for messages)
+  Eigen::Index first_row = 0;     ///< 0-based data-row index of the chunk's first line
+  bool unterminated = false;      ///< the last line is the file's last and has no final newline
+  /// Number of data lines in the chunk.
+  Eigen::Index rows() const { return static_cast<Eigen::Index>(ends.size()); }
+};
+
 /// Streaming CSV reader with constant memory: reads the header on construction, then yields blocks
 /// of at most chunk_rows rows. Same format and errors as read_csv (csv_reader.hpp); an error is
 /// thrown by the next() call that reaches the faulty line. Use it for files too large to hold
@@ -36,6 +49,17 @@ class CsvChunkReader {
   /// storage is reused while the size is unchanged). Returns false, with block left empty, once the
   /// file is exhausted. Throws dynid::Error for malformed rows (file, line, column, fix).
   bool next(Eigen::MatrixXd& block);
+
+  /// next() in two halves, for a pipeline: next_text cuts the next rows (as next() would yield
+  /// them) without parsing, reusing `chunk`'s storage. Returns false, with chunk empty, once the
+  /// file is exhausted. Throws dynid::Error for read errors, over-long lines and a file with a
+  /// header but no data rows; malformed numbers are found by parse_text.
+  bool next_text(CsvTextChunk& chunk);
+
+  /// Parses a chunk cut by next_text of this reader into `block` (resized to chunk.rows() ×
+  /// columns().size()), with the errors of next() (file, line, column, fix). Reads only the
+  /// header, so other threads may call it while next_text cuts the following chunks.
+  void parse_text(const CsvTextChunk& chunk, Eigen::MatrixXd& block) const;
 
   /// Number of data rows yielded so far.
   Eigen::Index rows_read() const;
