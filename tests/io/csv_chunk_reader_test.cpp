@@ -159,6 +159,27 @@ TEST(CsvChunkReader, TextChunksParsedOnOtherThreadsEqualTheWholeFile) {
   }
   EXPECT_EQ(row, 700);
   EXPECT_TRUE(chunks.back().unterminated);
+  // Wide rows: a chunk ends once it holds 16 MiB of text (20 lines of 1.02 MB: 17 + 3 lines), so
+  // the chunks queued between threads stay bounded; the rows are still those of read_csv.
+  {
+    std::string wide = "c0";
+    for (int c = 1; c < 60000; ++c) wide += ",c" + std::to_string(c);
+    wide += "\n";
+    std::string line = "0.12345678901234";
+    for (int c = 1; c < 60000; ++c) line += ",0.12345678901234";
+    line += "\n";
+    for (int r = 0; r < 20; ++r) wide += line;
+    const std::string big = dir.write("wide.csv", wide);
+    CsvChunkReader wide_reader(big, {4096, 1 << 20});
+    std::vector<Eigen::Index> sizes;
+    Eigen::MatrixXd parsed;
+    while (wide_reader.next_text(chunk)) {
+      sizes.push_back(chunk.rows());
+      wide_reader.parse_text(chunk, parsed);
+      EXPECT_TRUE((parsed.array() == 0.12345678901234).all());
+    }
+    EXPECT_EQ(sizes, (std::vector<Eigen::Index>{17, 3}));
+  }
   // A malformed row cut before an over-long line of the same chunk is the error reported, as a
   // row-by-row read finds it first; on its own chunk, the bad field names its file line.
   const std::string bad = dir.write(

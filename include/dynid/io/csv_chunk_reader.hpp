@@ -51,9 +51,10 @@ class CsvChunkReader {
   bool next(Eigen::MatrixXd& block);
 
   /// next() in two halves, for a pipeline: next_text cuts the next rows (as next() would yield
-  /// them) without parsing, reusing `chunk`'s storage. Returns false, with chunk empty, once the
-  /// file is exhausted. Throws dynid::Error for read errors, over-long lines and a file with a
-  /// header but no data rows; malformed numbers are found by parse_text.
+  /// them: at most chunk_rows, fewer once the chunk holds 16 MiB of text) without parsing, reusing
+  /// `chunk`'s storage. Returns false, with chunk empty, once the file is exhausted. Throws
+  /// dynid::Error for read errors, over-long lines and a file with a header but no data rows;
+  /// malformed numbers are found by parse_text.
   bool next_text(CsvTextChunk& chunk);
 
   /// Parses a chunk cut by next_text of this reader into `block` (resized to chunk.rows() ×
