@@ -340,7 +340,11 @@ GravityPosesResult fit_gravity_poses(const Model& model, const std::vector<Proce
   // (q_J as measured) after the slope constants, classified with a tolerance that treats poses
   // closer than distinct_pose_tolerance as one. Measured held joints would make every column
   // look independent through their noise alone.
-  Eigen::MatrixXd W = Eigen::MatrixXd::Zero(rows, rg + S);
+  // The cruise is closed-loop: the controller's ripple leaves q̈_J ≠ 0, and it follows the
+  // gravity load, so left out it would bias θ_g. One equivalent inertia per run (M_JJ depends on
+  // the held joints only, which are fixed in a run) takes it: τ_J += M_r·q̈_J.
+  const auto R = static_cast<Eigen::Index>(runs.size());
+  Eigen::MatrixXd W = Eigen::MatrixXd::Zero(rows, rg + S + R);
   Eigen::MatrixXd at_pose = Eigen::MatrixXd::Zero(rows, S + rg);
   Eigen::VectorXd y(rows);
   for (Eigen::Index i = 0; i < rows; ++i) {
@@ -349,6 +353,7 @@ GravityPosesResult fit_gravity_poses(const Model& model, const std::vector<Proce
     const Eigen::VectorXd q = runs[r].record.q.row(k).transpose();
     W.row(i).head(rg) = base.select(gravity_row(q));
     W(i, rg + s) = 1.0;
+    W(i, rg + S + r) = runs[r].record.ddq(k, joint);
     Eigen::VectorXd held = out.pose[r];
     held[joint] = q[joint];
     at_pose.row(i).tail(rg) = base.select(gravity_row(held));
@@ -405,6 +410,7 @@ GravityPosesResult fit_gravity_poses(const Model& model, const std::vector<Proce
     out.slope_rows.push_back(static_cast<Eigen::Index>(s.samples.size()));
     eo.names.push_back("c(" + out.slope_names.back() + ")");
   }
+  for (Eigen::Index r = 0; r < R; ++r) eo.names.push_back("M(run " + std::to_string(r + 1) + ")");
   out.estimate = ordinary_least_squares(W, y, Eigen::VectorXi(), eo);
   const Eigen::VectorXd e = y - W * out.estimate.x;
   const HacSummary h = apply_hac_covariance(out.estimate, W, e, cruise.sample, eo);

@@ -77,7 +77,8 @@ struct GravityPosesResult {
   /// combinations of the links J moves, named and regrouped as in compute_base_parameters()
   /// (`MX2R = MX2 + 0.4*M2`), in the order of `estimate.x`.
   std::vector<std::string> names, expressions;
-  /// x = [θ_g, c_1, …, c_S] (c_s the constant of slope s), HAC covariance and intervals.
+  /// x = [θ_g, c_1, …, c_S, M_1, …, M_R] (c_s the constant of slope s, M_r the equivalent
+  /// inertia of run r for the controller's q̈_J ripple on the cruise), HAC covariance, intervals.
   Estimate estimate;
   double confidence_level = 0.0;
   /// Per run: the pose of the joints (mean over its cruise samples; entry J is meaningless)
@@ -96,9 +97,9 @@ struct GravityPosesResult {
   std::vector<std::string> warnings;                         ///< named, human-readable
 };
 
-/// Fits τ_J = Y_g,J(q)·θ_g + c_s on the cruise samples of slope runs of joint J in which the other
-/// joints are held at a pose that changes between runs (seed 2 §3.2.1, eq. 23 generalised to
-/// all q; docs/methods/experiments.md). Y_g,J is row J of the torque regressor at q̇ = q̈ = 0
+/// Fits τ_J = Y_g,J(q)·θ_g + c_s + M_r·q̈_J on the cruise samples of slope runs of joint J in which
+/// the other joints are held at a pose that changes between runs (seed 2 §3.2.1, eq. 23 generalised
+/// to all q; docs/methods/experiments.md). Y_g,J is row J of the torque regressor at q̇ = q̈ = 0
 /// restricted to its base columns (classify_columns() on random poses), c_s one constant per
 /// slope (friction and the velocity terms of the held joints). Intervals: HAC over samples.
 /// Throws dynid::Error for a joint outside the model, runs of another robot, a run without a
