@@ -904,7 +904,8 @@ void add_identify_command(CLI::App& app) {
   cmd->add_option("--model", o->model,
                   "differential (joint torques, default), integral (energy over intervals: "
                   "Dutkiewicz, Kozlowski, Wroblewski 1993), or one joint's dedicated experiment "
-                  "(Bona, Curatella 2005): gravity (constant-velocity slopes), friction "
+                  "(Bona, Curatella 2005): gravity (constant-velocity slopes; over all q "
+                  "when the runs hold the other joints at different poses), friction "
                   "(bang-bang moves, inertia and gravity compensated) or decoupled (one joint "
                   "moving, the others held)");
   cmd->add_option("--interval", o->interval,
