@@ -376,6 +376,33 @@ void refuse_undetermined(const IdentifiedResultFile& f, const std::string& path,
               "; identify from runs that also excite them");
 }
 
+// A result identified with --friction-known stores that friction in options.known_friction: add
+// it back (names, values and layout), so that its predictions are full torques.
+void add_stored_known_friction(const IdentifiedResultFile& f, const std::string& path,
+                               const Model& model, std::vector<std::string>& names,
+                               Eigen::VectorXd& values, IdentifyOptions& options) {
+  const auto it = f.options.find("known_friction");
+  if (it == f.options.end()) return;
+  std::vector<std::string> known_names;
+  std::vector<double> known_values;
+  try {
+    for (const auto& p : *it) {
+      known_names.push_back(p.at("name").get<std::string>());
+      known_values.push_back(p.at("value").get<double>());
+    }
+  } catch (const nlohmann::json::exception&) {
+    throw Error("'" + path +
+                "': options.known_friction must list {name, value}; give the result of "
+                "identify --friction-known unedited");
+  }
+  KnownFriction known;
+  add_known_friction(known, model, known_names,
+                     Eigen::Map<const Eigen::VectorXd>(
+                         known_values.data(), static_cast<Eigen::Index>(known_values.size())),
+                     path);
+  append_known_friction(known, names, values, options.layout);
+}
+
 // The model whose rigid-body and armature torques a friction experiment subtracts: the robot's
 // nominal one, or the one identified in `params` (its base parameters, the rest nominal).
 Model compensation_model(const Model& model, const std::string& params) {
@@ -387,7 +414,11 @@ Model compensation_model(const Model& model, const std::string& params) {
   const FileOptions file_options{f.options, params};
   o.friction = file_options.get("friction", o.friction);
   o.no_armature = !file_options.get("armature", true);
-  return identified_model(model, f.names, f.values, library_options(o));
+  IdentifyOptions options = library_options(o);
+  std::vector<std::string> names = f.names;
+  Eigen::VectorXd values = f.values;
+  add_stored_known_friction(f, params, model, names, values, options);
+  return identified_model(model, names, values, options);
 }
 
 // `identify --model gravity|friction|decoupled`: seed 2's dedicated experiments on one joint.
@@ -422,9 +453,15 @@ void run_experiment(const IdentifyCliOptions& o, const IdentifyOptions& options,
   if (o.model == "gravity") {
     GravityExperimentOptions go;
     go.confidence_level = options.confidence_level;
-    GravityExperimentResult r = fit_gravity_experiment(runs, j, go);
-    r.choices.insert(r.choices.begin(), choices.begin(), choices.end());
-    result = gravity_experiment_to_json(model, r, used);
+    if (count_distinct_poses(runs, j, go) > 1) {  // the general form: gravity of J over all q
+      GravityPosesResult r = fit_gravity_poses(model, runs, j, go);
+      r.choices.insert(r.choices.begin(), choices.begin(), choices.end());
+      result = gravity_poses_to_json(model, r, used);
+    } else {
+      GravityExperimentResult r = fit_gravity_experiment(runs, j, go);
+      r.choices.insert(r.choices.begin(), choices.begin(), choices.end());
+      result = gravity_experiment_to_json(model, r, used);
+    }
   } else if (o.model == "friction") {
     FrictionExperimentOptions fo;
     fo.confidence_level = options.confidence_level;
@@ -569,6 +606,15 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   used["filter_coulomb_columns"] = result.processed.moving_positive.size() != 0;
   if (o.runs.size() > 1) used["data_runs"] = o.runs;
   if (!o.history.empty()) used["history"] = o.history;
+  if (!options.known_friction.empty()) {
+    std::vector<std::string> known_names;
+    Eigen::VectorXd known_values;
+    known_friction_parameters(options.known_friction, known_names, known_values);
+    used["known_friction"] = nlohmann::json::array();
+    for (size_t i = 0; i < known_names.size(); ++i)
+      used["known_friction"].push_back(
+          {{"name", known_names[i]}, {"value", known_values[static_cast<Eigen::Index>(i)]}});
+  }
   nlohmann::json out = identification_to_json(model, result, used);
   if (closed) out["closed_loop"] = closed_loop_to_json(result.closed_loop);
   if (!o.repeat.empty()) {
@@ -582,9 +628,12 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   if (!records.empty()) {
     IdentifyOptions same = options;
     same.signal.cutoff_hz = result.processed.cutoff_hz;
+    std::vector<std::string> names = result.names;
+    Eigen::VectorXd values = result.estimate.x;
+    append_known_friction(options.known_friction, names, values, same.layout);
     try {
-      first_run_fit = validate_torques(model, records.front(), result.names, result.estimate.x,
-                                       same, result.not_excited);
+      first_run_fit =
+          validate_torques(model, records.front(), names, values, same, result.not_excited);
       out["plot"] = prediction_plot_json(*first_run_fit, joint_names(model));
     } catch (const Error& e) {  // the result stands without its plot
       warn(std::string("no torque plot in the result: ") + e.what());
@@ -692,15 +741,16 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
   const IdentifiedResultFile identified = read_identification_result(v.params);
   require_same_robot(identified.robot, model.name, "'" + v.params + "'",
                      "validate with the robot the parameters were identified on");
-  const std::vector<std::string>& names = identified.names;
-  const Eigen::VectorXd& values = identified.values;
+  std::vector<std::string> names = identified.names;
+  Eigen::VectorXd values = identified.values;
   RunFileReport read;
   ResultOptionOverrides overrides;
   if (cmd.count("--cutoff")) overrides.cutoff = v.cutoff;
   overrides.zero_velocity = v.zero_velocity;
   overrides.torque_scale_given = !v.torque_scale.empty() || cmd.count("--torque-scale");
-  const IdentifyOptions options =
+  IdentifyOptions options =
       options_from_identification_result(identified, v.params, model.dof(), overrides, file, read);
+  add_stored_known_friction(identified, v.params, model, names, values, options);
   const JointRecord record = read_joint_record(v.data, model, file, &read);
   if (v.mode == "simulation") {
     RunFileOptions reference_file;
@@ -854,7 +904,8 @@ void add_identify_command(CLI::App& app) {
   cmd->add_option("--model", o->model,
                   "differential (joint torques, default), integral (energy over intervals: "
                   "Dutkiewicz, Kozlowski, Wroblewski 1993), or one joint's dedicated experiment "
-                  "(Bona, Curatella 2005): gravity (constant-velocity slopes), friction "
+                  "(Bona, Curatella 2005): gravity (constant-velocity slopes; over all q "
+                  "when the runs hold the other joints at different poses), friction "
                   "(bang-bang moves, inertia and gravity compensated) or decoupled (one joint "
                   "moving, the others held)");
   cmd->add_option("--interval", o->interval,

@@ -75,6 +75,16 @@ FrictionExperimentResult fit_friction_experiment(const Model& model,
   out.sample_t.resize(rows);
   out.sample_dq.resize(rows);
   Eigen::Index i = 0, offset = 0, positive = 0, negative = 0;
+  // Samples of each direction (up, down) that accelerate or decelerate by more than a fifth of the
+  // peak |q̈_J|: an error of the compensated inertia adds ΔM·q̈ to τ_f, which averages out only
+  // when each direction has both phases; with one sign it aliases into the Coulomb level.
+  double peak_ddq = 0.0;
+  for (const auto& p : runs) {
+    for (Eigen::Index k = 0; k < p.record.t.size(); ++k)
+      if (std::abs(p.record.dq(k, joint)) >= threshold)
+        peak_ddq = std::max(peak_ddq, std::abs(p.record.ddq(k, joint)));
+  }
+  Eigen::Index speeding[2] = {0, 0}, braking[2] = {0, 0};
   bool expected_sign = true;
   for (size_t r = 0; r < runs.size(); ++r) {
     const ProcessedRecord& p = runs[r];
@@ -89,6 +99,9 @@ FrictionExperimentResult fit_friction_experiment(const Model& model,
       y[i] = p.record.tau(k, joint) - tau[joint];
       positive += v > 0.0;
       negative += v < 0.0;
+      const double along = p.record.ddq(k, joint) * (v > 0.0 ? 1.0 : -1.0);
+      speeding[v < 0.0] += along > 0.2 * peak_ddq;
+      braking[v < 0.0] += along < -0.2 * peak_ddq;
       sample[i] = static_cast<int>(offset + k);
       out.sample_run[i] = static_cast<int>(r);
       out.sample_t[i] = p.record.t[k];
@@ -105,6 +118,17 @@ FrictionExperimentResult fit_friction_experiment(const Model& model,
       << " in only " << std::min(positive, negative)
       << " samples above the zero-velocity threshold " << threshold
       << "; asymmetric friction needs both directions: record back-and-forth moves "
+         "(dynid excite --family bang-bang)";
+    throw Error(m.str());
+  }
+  for (int d = 0; d < 2; ++d) {
+    if (std::min(speeding[d], braking[d]) >= kMinimumPerDirection) continue;
+    std::ostringstream m;
+    m << "joint " << joint + 1 << " moving " << (d == 0 ? "up" : "down") << " "
+      << (braking[d] < kMinimumPerDirection ? "never decelerates" : "never accelerates") << " ("
+      << std::min(speeding[d], braking[d]) << " samples beyond a fifth of the peak |ddq|): a "
+      << "friction run must speed up and slow down in each direction, or an error of the "
+         "compensated inertia is fitted as Coulomb friction; record the whole bang-bang move "
          "(dynid excite --family bang-bang)";
     throw Error(m.str());
   }
@@ -230,6 +254,47 @@ void subtract_known_friction(const Model& model, const KnownFriction& friction,
   const Eigen::VectorXd tau_f = W * theta;
   for (Eigen::Index i = 0; i < block.y.size(); ++i)
     block.y[i] -= tau_f[static_cast<Eigen::Index>(block.sample[i]) * n + block.group[i]];
+}
+
+void known_friction_parameters(const KnownFriction& friction, std::vector<std::string>& names,
+                               Eigen::VectorXd& values) {
+  names.clear();
+  std::vector<double> v;
+  for (size_t j = 0; j < friction.given.size(); ++j) {
+    if (!friction.given[j]) continue;
+    const auto i = static_cast<Eigen::Index>(j);
+    const std::string n = std::to_string(j + 1);
+    for (const char* prefix : {"Fvp", "Fvn", "Fcp", "Fcn"}) names.push_back(prefix + n);
+    v.insert(v.end(), {friction.fvp[i], friction.fvn[i], friction.fcp[i], friction.fcn[i]});
+  }
+  values = Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+}
+
+void append_known_friction(const KnownFriction& friction, std::vector<std::string>& names,
+                           Eigen::VectorXd& values, ParameterLayout& layout) {
+  if (friction.empty()) return;
+  if (layout.viscous || layout.coulomb) {
+    throw Error(
+        "a result identified with known friction has no friction columns of its own; its "
+        "options name a friction set too (give the result of identify --friction-known "
+        "unedited)");
+  }
+  if (static_cast<Eigen::Index>(names.size()) != values.size()) {
+    throw Error("parameter names and values differ in size");
+  }
+  const auto n = static_cast<Eigen::Index>(friction.given.size());
+  Eigen::VectorXd out(values.size() + 4 * n);
+  out.head(values.size()) = values;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const bool given = friction.given[static_cast<size_t>(j)];
+    const std::string s = std::to_string(j + 1);
+    for (const char* prefix : {"Fvp", "Fvn", "Fcp", "Fcn"}) names.push_back(prefix + s);
+    out.segment<4>(values.size() + 4 * j) << (given ? friction.fvp[j] : 0.0),
+        (given ? friction.fvn[j] : 0.0), (given ? friction.fcp[j] : 0.0),
+        (given ? friction.fcn[j] : 0.0);
+  }
+  values = out;
+  layout.viscous = layout.coulomb = layout.asymmetric = true;
 }
 
 }  // namespace dynid

@@ -71,6 +71,20 @@ double critical(const Estimate& e) {
   return e.critical_value > 0.0 ? e.critical_value : e.t_quantile;
 }
 
+// `slopes` of a gravity result: per slope its name, cruise velocity, offset and rows.
+template <typename Result>
+nlohmann::json slopes_json(const Result& r) {
+  nlohmann::json slopes = nlohmann::json::array();
+  for (size_t s = 0; s < r.slope_names.size(); ++s) {
+    slopes.push_back({{"name", r.slope_names[s]},
+                      {"velocity", json_number(r.slope_velocity[s])},
+                      {"offset", json_number(r.offset[s])},
+                      {"offset_std", json_number(r.offset_std[s])},
+                      {"rows", r.slope_rows[s]}});
+  }
+  return slopes;
+}
+
 }  // namespace
 
 nlohmann::json gravity_experiment_to_json(const Model& model, const GravityExperimentResult& r,
@@ -82,15 +96,7 @@ nlohmann::json gravity_experiment_to_json(const Model& model, const GravityExper
   params.push_back(parameter("qoff" + j, r.q_off, r.q_off_std, c));
   nlohmann::json out = common(model, "gravity", r.joint, std::move(params), r.estimate, r.choices,
                               r.warnings, options_used);
-  nlohmann::json slopes = nlohmann::json::array();
-  for (size_t s = 0; s < r.slope_names.size(); ++s) {
-    slopes.push_back({{"name", r.slope_names[s]},
-                      {"velocity", json_number(r.slope_velocity[s])},
-                      {"offset", json_number(r.offset[s])},
-                      {"offset_std", json_number(r.offset_std[s])},
-                      {"rows", r.slope_rows[s]}});
-  }
-  out["slopes"] = slopes;
+  out["slopes"] = slopes_json(r);
   out["rows"] = r.rows;
   out["relative_error"] = json_number(r.relative_error);
   out["residual_rms"] = json_number(r.residual_rms);
@@ -98,6 +104,35 @@ nlohmann::json gravity_experiment_to_json(const Model& model, const GravityExper
                 {"q", numbers(r.sample_q)},
                 {"tau", numbers(r.sample_tau)},
                 {"fitted", numbers(r.sample_fitted)}};
+  return out;
+}
+
+nlohmann::json gravity_poses_to_json(const Model& model, const GravityPosesResult& r,
+                                     const nlohmann::json& options_used) {
+  nlohmann::json params = nlohmann::json::array();
+  const auto rg = static_cast<Eigen::Index>(r.names.size());
+  add_estimated(params, r.names, r.estimate, 0, rg);
+  nlohmann::json out = common(model, "gravity", r.joint, std::move(params), r.estimate, r.choices,
+                              r.warnings, options_used);
+  nlohmann::json base = nlohmann::json::array();
+  for (size_t i = 0; i < r.names.size(); ++i)
+    base.push_back({{"name", r.names[i]}, {"expression", r.expressions[i]}});
+  out["base_parameters"] = base;
+  nlohmann::json poses = nlohmann::json::array();
+  for (size_t p = 0; p < r.k.size(); ++p) {
+    poses.push_back({{"pose", numbers(r.pose[p])},
+                     {"k", json_number(r.k[p])},
+                     {"k_std", json_number(r.k_std[p])},
+                     {"k_ci_half_width", json_number(r.k_ci_half_width[p])},
+                     {"qoff", json_number(r.q_off[p])},
+                     {"qoff_std", json_number(r.q_off_std[p])},
+                     {"qoff_ci_half_width", json_number(r.q_off_ci_half_width[p])}});
+  }
+  out["poses"] = poses;
+  out["slopes"] = slopes_json(r);
+  out["rows"] = r.rows;
+  out["relative_error"] = json_number(r.relative_error);
+  out["residual_rms"] = json_number(r.residual_rms);
   return out;
 }
 

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -82,6 +84,41 @@ TEST(IdentifyModelsCli, GravityOfTheElbowFromSlopes) {
   EXPECT_EQ(j["slopes"].size(), 2u);
 }
 
+// Item 2's general form through the command line: slopes of the shoulder with the elbow held at
+// two poses give the shoulder's 4 gravity base parameters and k, qoff per pose; the truth per pose
+// is RNEA's gravity torque.
+TEST(IdentifyModelsCli, GravityOfTheShoulderAtTwoElbowPoses) {
+  std::vector<std::string> data;
+  for (const char* pose : {"0,-0.5", "0,0.9"}) {
+    data.push_back(simulated("shoulder_slopes_" + std::to_string(data.size()),
+                             "--family slope --joint 1 --range -1.2:1.2 --velocity 0.6 "
+                             "--acceleration 2 --pose " +
+                                 std::string(pose) + " --cycles 1"));
+  }
+  const std::string out = (scratch() / "gravity_poses.json").string();
+  const auto r = run("identify --robot planar2 --model gravity --joint 1 --data " + data[0] +
+                     " --data " + data[1] + " --torque-offset 0.0025 --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = load(out);
+  EXPECT_EQ(j["experiment"], "gravity");
+  EXPECT_EQ(j["parameters"].size(), 4u) << j["base_parameters"].dump();
+  ASSERT_EQ(j["poses"].size(), 2u);
+  const Model m = load_robot("planar2");
+  RneaOptions g;
+  g.joint_terms = false;
+  const Eigen::Vector2d zero(0, 0);
+  for (const auto& p : j["poses"]) {
+    const double elbow = p["pose"][1].get<double>();
+    const double a = rnea(m, Eigen::Vector2d(M_PI / 2, elbow), zero, zero, g)[0];
+    const double b = rnea(m, Eigen::Vector2d(0.0, elbow), zero, zero, g)[0];
+    const double k = p["k"].get<double>(), qoff = p["qoff"].get<double>();
+    const double dk = p["k_ci_half_width"].get<double>();
+    const double dq = p["qoff_ci_half_width"].get<double>();
+    EXPECT_NEAR(k * std::cos(qoff), a, dk + std::abs(k) * dq) << p.dump();
+    EXPECT_NEAR(k * std::sin(qoff), b, dk + std::abs(k) * dq) << p.dump();
+  }
+}
+
 TEST(IdentifyModelsCli, FrictionAndDecoupledModelsRunAndNameTheirParameters) {
   const std::string data = simulated(
       "bangbang", "--family bang-bang --joint 1 --range -1:1 --acceleration 4 --pose 0,0.5");
@@ -144,6 +181,171 @@ TEST(IdentifyModelsCli, IntegralModelUsesTheDifferentialBaseParameters) {
             1.1 * jp["physical"]["relative_error_unconstrained"].get<double>());
   EXPECT_LT(jp["physical"]["mahalanobis"].get<double>(),
             jp["physical"]["chi2_limit"].get<double>());
+}
+
+// The lines of a CSV file (header first, comments dropped).
+std::vector<std::string> csv_lines(const std::string& path) {
+  std::ifstream f(path);
+  std::vector<std::string> out;
+  for (std::string line; std::getline(f, line);)
+    if (!line.empty() && line[0] != '#') out.push_back(line);
+  return out;
+}
+
+// Column `name` of a CSV data line.
+double csv_value(const std::string& header, const std::string& line, const std::string& name) {
+  std::istringstream h(header), l(line);
+  std::string column, value;
+  while (std::getline(h, column, ',') && std::getline(l, value, ','))
+    if (column == name) return std::stod(value);
+  ADD_FAILURE() << "no column " << name << " in " << header;
+  return 0.0;
+}
+
+// Rows [from, to) of a CSV run written as a new run file.
+std::string csv_slice(const std::vector<std::string>& lines, size_t from, size_t to,
+                      const std::string& name) {
+  const std::string path = (scratch() / name).string();
+  std::ofstream f(path);
+  f << lines[0] << '\n';
+  for (size_t i = from; i < to && i < lines.size(); ++i) f << lines[i] << '\n';
+  return path;
+}
+
+// Issue 14 item 10: each experiment input a user can get wrong gives one error line, exit 1 for
+// data (2 for usage), no result file. The runs are cut from one simulated bang-bang run of the
+// shoulder (-1 -> 1 -> -1 rad): its rising half (one direction only), and the speeding-up parts
+// of each direction (no deceleration).
+TEST(IdentifyModelsCli, BadExperimentRunsGiveOneErrorLine) {
+  const std::string data = simulated(
+      "bangbang_bad", "--family bang-bang --joint 1 --range -1:1 --acceleration 4 --pose 0,0.5");
+  const std::vector<std::string> lines = csv_lines(data);
+  ASSERT_GT(lines.size(), 100u);
+  // The first rise of q1: from the start to its first maximum; its midpoint crossing q1 = 0.
+  size_t top = 1, mid_up = 0, mid_down = 0;
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const double q = csv_value(lines[0], lines[i], "q1");
+    if (q > csv_value(lines[0], lines[top], "q1") + 1e-9) top = i;
+    if (mid_up == 0 && q > 0.0) mid_up = i;
+    if (top > 1 && q < csv_value(lines[0], lines[top], "q1") - 0.5) break;  // past the top
+  }
+  for (size_t i = top; i < lines.size(); ++i)
+    if (csv_value(lines[0], lines[i], "q1") < 0.0) {
+      mid_down = i;
+      break;
+    }
+  ASSERT_GT(mid_up, 1u);
+  ASSERT_GT(mid_down, top);
+  const std::string rising = csv_slice(lines, 1, top, "rising.csv");
+  const std::string speeding_up = csv_slice(lines, 1, mid_up, "speeding_up.csv");
+  const std::string speeding_down = csv_slice(lines, top, mid_down, "speeding_down.csv");
+  const std::string bad = (scratch() / "bad_experiment.json").string();
+  struct Case {
+    std::string args, message;
+    int code;
+  };
+  const std::vector<Case> cases = {
+      {"--model gravity --joint 1 --data " + data, "without a constant-velocity part", 1},
+      {"--model friction --joint 3 --data " + data, "--joint 3", 2},
+      {"--model friction --joint 1 --data " + rising, "both directions", 1},
+      {"--model friction --joint 1 --data " + speeding_up + " --data " + speeding_down,
+       "never decelerates", 1},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.args);
+    const auto r = run("identify --robot planar2 " + c.args + " --out " + bad);
+    EXPECT_EQ(r.code, c.code) << r.err;
+    EXPECT_EQ(testing::error_contract_problem(r.err), "");
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(bad));
+  }
+}
+
+// Issue 14 items 4 and 5: `identify --friction-known` on planar2 with asymmetric friction (a model
+// file with Fv, Fc and an offset Fo per joint, so Fcp = Fc + Fo and Fcn = Fc - Fo), friction from
+// a bang-bang run of each joint, then a multi-sine run of both joints. The result stores the known
+// friction, and validate predicts the full torque with it: its error is well below that of the
+// same result with the stored friction removed (the rigid body alone, as before the fix).
+TEST(IdentifyModelsCli, FrictionKnownResultIsValidatedWithItsFriction) {
+  std::ifstream in(std::string(DYNID_SOURCE_DIR) + "/examples/robots/planar2.yaml");
+  std::stringstream yaml;
+  yaml << in.rdbuf();
+  std::string text = yaml.str();
+  const std::string robot = (scratch() / "planar2_friction.yaml").string();
+  {
+    const std::string shoulder =
+        "inertia_com: [0, 0, 0, 0.16666666666666666, 0, 0.16666666666666666]";
+    const std::string elbow = "inertia_com: [0, 0, 0, 0.08, 0, 0.08]";
+    text.replace(text.find(shoulder), shoulder.size(), shoulder + ", Fv: 1.5, Fc: 2.0, Fo: 0.4");
+    text.replace(text.find(elbow), elbow.size(), elbow + ", Fv: 0.8, Fc: 1.0, Fo: -0.2");
+    std::ofstream(robot) << text;
+  }
+  std::vector<std::string> known;
+  for (int joint : {1, 2}) {
+    const std::string j = std::to_string(joint);
+    const std::string ref = (scratch() / ("bb" + j + "_ref.csv")).string();
+    const std::string run_file = (scratch() / ("bb" + j + ".csv")).string();
+    auto r = run("excite --robot " + robot + " --family bang-bang --joint " + j +
+                 " --range -1:1 --acceleration 4 --pose 0.4,0.4 --rate 200 --out " + ref);
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = run("simulate --robot " + robot + " --trajectory " + ref +
+            " --periods 2 --position-noise 1e-5 --torque-noise 0.02 --out " + run_file);
+    ASSERT_EQ(r.code, 0) << r.err;
+    known.push_back((scratch() / ("friction" + j + ".json")).string());
+    r = run("identify --robot " + robot + " --model friction --joint " + j + " --data " + run_file +
+            " --torque-offset 0.0025 --out " + known.back());
+    ASSERT_EQ(r.code, 0) << r.err;
+  }
+  // A 3-sine reference of both joints (period 5 s), written directly: q, dq, ddq exact.
+  const std::string ref = (scratch() / "multisine_ref.csv").string();
+  {
+    std::ofstream f(ref);
+    f << "t,q1,q2,dq1,dq2,ddq1,ddq2\n";
+    const double w = 2 * M_PI * 0.2;
+    const double a[2][3] = {{0.8, 0.3, 0.15}, {0.9, -0.4, 0.2}};
+    for (int k = 0; k < 1000; ++k) {
+      const double t = k / 200.0;
+      double q[2] = {0, 0.3}, dq[2] = {0, 0}, ddq[2] = {0, 0};
+      for (int j = 0; j < 2; ++j)
+        for (int h = 0; h < 3; ++h) {
+          const double wh = (h + 1) * w, ph = 0.7 * j + 0.4 * h;
+          q[j] += a[j][h] / wh * std::sin(wh * t + ph);
+          dq[j] += a[j][h] * std::cos(wh * t + ph);
+          ddq[j] -= a[j][h] * wh * std::sin(wh * t + ph);
+        }
+      f << t << ',' << q[0] << ',' << q[1] << ',' << dq[0] << ',' << dq[1] << ',' << ddq[0] << ','
+        << ddq[1] << '\n';
+    }
+  }
+  const std::string data = (scratch() / "multisine.csv").string();
+  auto r = run("simulate --robot " + robot + " --trajectory " + ref +
+               " --periods 3 --position-noise 1e-5 --torque-noise 0.02 --out " + data);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string result = (scratch() / "known.json").string();
+  r = run("identify --robot " + robot + " --data " + data + " --friction-known " + known[0] +
+          " --friction-known " + known[1] + " --torque-offset 0.0025 --out " + result);
+  ASSERT_EQ(r.code, 0) << r.err;
+  nlohmann::json j = load(result);
+  for (const auto& p : j["parameters"])  // only the rigid body (and armature) was estimated
+    EXPECT_EQ(p["name"].get<std::string>().rfind("F", 0), std::string::npos) << p["name"];
+  ASSERT_EQ(j["options"]["known_friction"].size(), 8u);
+  EXPECT_EQ(j["options"]["known_friction"][0]["name"], "Fvp1");
+  const std::string with = (scratch() / "validate_with.json").string();
+  r = run("validate --robot " + robot + " --params " + result + " --data " + data + " --json " +
+          with);
+  ASSERT_EQ(r.code, 0) << r.err;
+  // Negative control: the same result without its stored friction.
+  j["options"].erase("known_friction");
+  const std::string stripped = (scratch() / "known_stripped.json").string();
+  std::ofstream(stripped) << j.dump();
+  const std::string without = (scratch() / "validate_without.json").string();
+  r = run("validate --robot " + robot + " --params " + stripped + " --data " + data + " --json " +
+          without);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const double e_with = load(with)["relative_error"].get<double>();
+  const double e_without = load(without)["relative_error"].get<double>();
+  EXPECT_LT(e_with, 0.5 * e_without) << "with " << e_with << ", without " << e_without;
+  EXPECT_LT(e_with, 0.1);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -113,6 +114,37 @@ TEST(FrictionExperiment, OneDirectionOnlyIsRefused) {
     EXPECT_NE(std::string(e.what()).find("both directions"), std::string::npos) << e.what();
   }
   EXPECT_THROW(fit_friction_experiment(m, {full}, 2), UsageError);
+}
+
+// Issue 14 item 10: a bang-bang run cut so that it only speeds up (both directions, every speed,
+// but no braking) must be refused: the compensated inertia's error would be fitted as Coulomb.
+TEST(FrictionExperiment, ARunThatNeverDeceleratesIsRefused) {
+  const Model m = plant_model();
+  const ProcessedRecord full = bang_bang_run(m, 0, 3);
+  std::vector<Eigen::Index> speeding;
+  for (Eigen::Index k = 0; k < full.record.t.size(); ++k)
+    if (full.record.dq(k, 0) * full.record.ddq(k, 0) >= 0.0) speeding.push_back(k);
+  ProcessedRecord p = full;
+  auto rows = [&](const Eigen::MatrixXd& x) {
+    Eigen::MatrixXd out(static_cast<Eigen::Index>(speeding.size()), x.cols());
+    for (size_t i = 0; i < speeding.size(); ++i)
+      out.row(static_cast<Eigen::Index>(i)) = x.row(speeding[i]);
+    return out;
+  };
+  p.record.t = rows(full.record.t);
+  p.record.q = rows(full.record.q);
+  p.record.dq = rows(full.record.dq);
+  p.record.ddq = rows(full.record.ddq);
+  p.record.tau = rows(full.record.tau);
+  p.moving_positive = rows(full.moving_positive);
+  p.moving_negative = rows(full.moving_negative);
+  try {
+    fit_friction_experiment(m, {p}, 0);
+    FAIL() << "a run without deceleration was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("never decelerates"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(fit_friction_experiment(m, {full}, 0));  // the whole run passes the check
 }
 
 }  // namespace

@@ -4,6 +4,9 @@
 // comes from RNEA's gravity torque at q_J = 0 and π/2 (τ_g = a·sin q + b·cos q), not from the fit's
 // equations. Fixed seeds.
 #include <cmath>
+#include <map>
+#include <sstream>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -14,6 +17,7 @@
 #include "dynid/excitation/slope_trajectory.hpp"
 #include "dynid/excitation/trajectory_samples.hpp"
 #include "dynid/model/robots.hpp"
+#include "dynid/regressor/parameter_layout.hpp"
 #include "dynid/sim/simulate_reference.hpp"
 #include "support/closed_loop_runs.hpp"
 
@@ -131,6 +135,80 @@ TEST(GravityExperiment, ARunWithoutConstantVelocityIsRefused) {
   }
   EXPECT_THROW(fit_gravity_experiment({prepared(m, slopes(0, {0, 0}, 0.6), 1)}, 2), UsageError);
   EXPECT_THROW(fit_gravity_experiment({}, 0), UsageError);
+}
+
+// The value of a base parameter from its expression ("MX1R = MX1 + 0.5*M2 - MY2") and the
+// standard parameters of the model: the truth of fit_gravity_poses() without its own reduction.
+double expression_value(const std::string& expression, const std::map<std::string, double>& theta) {
+  std::istringstream in(expression.substr(expression.find('=') + 1));
+  double value = 0.0, sign = 1.0;
+  std::string token;
+  while (in >> token) {
+    if (token == "+" || token == "-") {
+      sign = token == "-" ? -1.0 : 1.0;
+      continue;
+    }
+    const size_t star = token.find('*');
+    const double c = star == std::string::npos ? 1.0 : std::stod(token.substr(0, star));
+    value += sign * c * theta.at(star == std::string::npos ? token : token.substr(star + 1));
+    sign = 1.0;
+  }
+  return value;
+}
+
+// Item 2's general form: the shoulder's gravity depends on the elbow too (4 base parameters:
+// first moments of both links, the elbow's mass regrouped into the shoulder's), so slopes at one
+// elbow pose give k and q_off only; three elbow poses determine all four.
+TEST(GravityPoses, ShoulderGravityFromSlopesAtThreeElbowPoses) {
+  const Model m = plant_model();
+  const std::vector<double> elbow = {-0.6, 0.3, 1.0};
+  std::vector<ProcessedRecord> runs;
+  for (size_t i = 0; i < elbow.size(); ++i)
+    runs.push_back(prepared(m, slopes(0, {0.0, elbow[i]}, 0.6), 11 + static_cast<unsigned>(i)));
+  const GravityPosesResult r = fit_gravity_poses(m, runs, 0);
+  ASSERT_EQ(r.names.size(), 4u) << ::testing::PrintToString(r.expressions);
+  std::map<std::string, double> theta;
+  const std::vector<std::string> names = ParameterLayout::rigid().names(m.dof());
+  const Eigen::VectorXd values = ParameterLayout::rigid().parameters(m);
+  for (size_t i = 0; i < names.size(); ++i) theta[names[i]] = values[static_cast<Eigen::Index>(i)];
+  for (size_t i = 0; i < r.names.size(); ++i) {
+    const auto c = static_cast<Eigen::Index>(i);
+    const double truth = expression_value(r.expressions[i], theta);
+    const double half = r.estimate.ci_upper[c] - r.estimate.x[c];
+    EXPECT_NEAR(r.estimate.x[c], truth, half) << r.expressions[i];
+    // Informative, not merely wide: within 3 % of the largest gravity parameter.
+    EXPECT_LT(half, 0.03 * values.cwiseAbs().maxCoeff()) << r.names[i];
+  }
+  // Per pose, k and q_off agree with RNEA's gravity torque at that pose.
+  ASSERT_EQ(r.k.size(), elbow.size());
+  for (size_t p = 0; p < elbow.size(); ++p) {
+    SCOPED_TRACE("elbow at " + std::to_string(elbow[p]));
+    EXPECT_NEAR(r.pose[p][1], elbow[p], 1e-2);
+    const auto [k, q_off] = true_gravity(m, 0, r.pose[p]);
+    const auto [rk, rq] = same_side(r.k[p], r.q_off[p], q_off);
+    EXPECT_NEAR(rk, k, r.k_ci_half_width[p]);
+    EXPECT_NEAR(rq, q_off, r.q_off_ci_half_width[p]);
+  }
+  EXPECT_EQ(r.slope_names.size(), 2 * elbow.size());
+}
+
+TEST(GravityPoses, OnePoseOfTheOtherJointsIsRefusedNamingWhatIsMissing) {
+  const Model m = plant_model();
+  const std::vector<ProcessedRecord> runs = {prepared(m, slopes(0, {0.0, 0.3}, 0.6), 21),
+                                             prepared(m, slopes(0, {0.0, 0.3}, 0.4), 22)};
+  try {
+    fit_gravity_poses(m, runs, 0);
+    FAIL() << "one elbow pose was accepted";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("1 distinct pose,"), std::string::npos) << what;
+    EXPECT_NE(what.find("undetermined"), std::string::npos) << what;
+    EXPECT_NE(what.find("with joint 2 held at 2 or more different poses"), std::string::npos)
+        << what;
+  }
+  // The elbow's own gravity needs no other pose: its two parameters come from one.
+  EXPECT_EQ(fit_gravity_poses(m, {prepared(m, slopes(1, {0.3, 0.0}, 0.6), 23)}, 1).names.size(),
+            2u);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include "dynid/estimation/estimate.hpp"
 #include "dynid/estimation/identification.hpp"
+#include "dynid/estimation/known_friction.hpp"
 #include "dynid/model/model.hpp"
 
 namespace dynid {
@@ -61,5 +62,19 @@ FrictionExperimentResult fit_friction_experiment(const Model& model,
                                                  const std::vector<ProcessedRecord>& runs,
                                                  int joint,
                                                  const FrictionExperimentOptions& options = {});
+
+/// The known friction of the joints given, as the parameters Fvp<J> Fvn<J> Fcp<J> Fcn<J> (1-based
+/// J) that add_known_friction() reads back: what a result identified with it stores, so that it
+/// can be validated and simulated with its friction.
+void known_friction_parameters(const KnownFriction& friction, std::vector<std::string>& names,
+                               Eigen::VectorXd& values);
+
+/// Turns a rigid-body result fitted after subtract_known_friction() into one that predicts the
+/// full torque: appends Fvp<J> Fvn<J> Fcp<J> Fcn<J> of every joint (0 for the joints not given)
+/// to `names`/`values` and switches `layout` to asymmetric viscous and Coulomb columns, so that
+/// validate_torques() and identified_model() add the friction that the fit subtracted (seed 2
+/// §3.4). Throws dynid::Error when `layout` already has friction columns or the sizes differ.
+void append_known_friction(const KnownFriction& friction, std::vector<std::string>& names,
+                           Eigen::VectorXd& values, ParameterLayout& layout);
 
 }  // namespace dynid

@@ -8,6 +8,7 @@
 
 #include "dynid/estimation/estimate.hpp"
 #include "dynid/estimation/identification.hpp"
+#include "dynid/model/model.hpp"
 
 namespace dynid {
 
@@ -24,6 +25,10 @@ struct GravityExperimentOptions {
   double min_cruise_fraction = 0.3;
   /// Fewest cruise samples for a slope to be used [samples].
   int min_cruise_samples = 10;
+  /// fit_gravity_poses(): a gravity base parameter counts as determined by the poses of the runs
+  /// only if its column, at each run's mean pose, is independent of the columns before it by at
+  /// least this relative residual; poses closer than about this [rad] count as one pose.
+  double distinct_pose_tolerance = 1e-3;
 };
 
 /// Gravity of one joint from constant-velocity slopes (seed 2 §3.2.1, Table 1).
@@ -63,5 +68,51 @@ struct GravityExperimentResult {
 /// all, or slopes covering too little of q_J to separate k and q_off.
 GravityExperimentResult fit_gravity_experiment(const std::vector<ProcessedRecord>& runs, int joint,
                                                const GravityExperimentOptions& options = {});
+
+/// Gravity of one joint as a function of all q (seed 2 §3.2.1 generalised): slopes of joint J
+/// recorded with the other joints held at a different pose in each run.
+struct GravityPosesResult {
+  int joint = 0;  ///< 0-based joint index J
+  /// The base parameters of the gravity row J, τ_g,J(q) = Y_g,J(q)·θ_g: first-moment (and mass)
+  /// combinations of the links J moves, named and regrouped as in compute_base_parameters()
+  /// (`MX2R = MX2 + 0.4*M2`), in the order of `estimate.x`.
+  std::vector<std::string> names, expressions;
+  /// x = [θ_g, c_1, …, c_S, M_1, …, M_R] (c_s the constant of slope s, M_r the equivalent
+  /// inertia of run r for the controller's q̈_J ripple on the cruise), HAC covariance, intervals.
+  Estimate estimate;
+  double confidence_level = 0.0;
+  /// Per run: the pose of the joints (mean over its cruise samples; entry J is meaningless)
+  /// [rad or m], and k·sin(q_J + q_off) at that pose with the delta-method std and interval
+  /// half-widths, for comparison with fit_gravity_experiment() (seed 2 Table 1).
+  std::vector<Eigen::VectorXd> pose;
+  std::vector<double> k, q_off, k_std, q_off_std, k_ci_half_width, q_off_ci_half_width;
+  /// Per slope (run, direction), as in GravityExperimentResult.
+  std::vector<std::string> slope_names;
+  std::vector<double> slope_velocity, offset, offset_std;
+  std::vector<Eigen::Index> slope_rows;
+  Eigen::Index rows = 0;        ///< cruise samples fitted
+  double relative_error = 0.0;  ///< ‖e‖/‖τ_J‖ on the cruise samples
+  double residual_rms = 0.0;    ///< [N·m or N]
+  std::vector<std::pair<std::string, std::string>> choices;  ///< what was decided and why
+  std::vector<std::string> warnings;                         ///< named, human-readable
+};
+
+/// Fits τ_J = Y_g,J(q)·θ_g + c_s + M_r·q̈_J on the cruise samples of slope runs of joint J in which
+/// the other joints are held at a pose that changes between runs (seed 2 §3.2.1, eq. 23 generalised
+/// to all q; docs/methods/experiments.md). Y_g,J is row J of the torque regressor at q̇ = q̈ = 0
+/// restricted to its base columns (classify_columns() on random poses), c_s one constant per
+/// slope (friction and the velocity terms of the held joints). Intervals: HAC over samples.
+/// Throws dynid::Error for a joint outside the model, runs of another robot, a run without a
+/// constant-velocity part, and runs whose poses do not determine θ_g (names the parameters
+/// missing and how many poses are needed: one pose gives only k and q_off).
+GravityPosesResult fit_gravity_poses(const Model& model, const std::vector<ProcessedRecord>& runs,
+                                     int joint, const GravityExperimentOptions& options = {});
+
+/// How many distinct poses of the joints other than J the runs hold (each run's mean position,
+/// poses within 10·options.distinct_pose_tolerance [rad or m] counted as one): above 1, the
+/// gravity of J can be fitted as a function of all q (fit_gravity_poses()). Throws dynid::Error
+/// for a joint outside a run.
+int count_distinct_poses(const std::vector<ProcessedRecord>& runs, int joint,
+                         const GravityExperimentOptions& options = {});
 
 }  // namespace dynid

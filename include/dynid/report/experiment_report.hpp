@@ -19,6 +19,13 @@ namespace dynid {
 nlohmann::json gravity_experiment_to_json(const Model& model, const GravityExperimentResult& r,
                                           const nlohmann::json& options_used);
 
+/// Result JSON of `dynid identify --model gravity` when the runs hold the other joints at
+/// several poses (fit_gravity_poses()): `parameters` the gravity base parameters of joint J with
+/// `base_parameters` (name, expression), `poses` (pose, k, k_std, k_ci_half_width, qoff,
+/// qoff_std, qoff_ci_half_width) for comparison with seed 2 Table 1, and `slopes` as above.
+nlohmann::json gravity_poses_to_json(const Model& model, const GravityPosesResult& r,
+                                     const nlohmann::json& options_used);
+
 /// Result JSON of `dynid identify --model friction` (seed 2 Table 2): `parameters` Fvp<J> Fvn<J>
 /// Fcp<J> Fcn<J>, `curve` (velocity, torque) and `fit` (run, t, dq, tau, fitted) for plotting.
 nlohmann::json friction_experiment_to_json(const Model& model, const FrictionExperimentResult& r,
