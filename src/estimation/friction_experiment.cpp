@@ -49,7 +49,7 @@ FrictionExperimentResult fit_friction_experiment(const Model& model,
   // Compensation with the rigid body and the armature only: the friction is what is sought.
   Model rigid = model;
   for (Joint& jt : rigid.joints) {
-    jt.friction.Fv = jt.friction.Fc = jt.friction.Fo = 0.0;
+    jt.friction.Fv = jt.friction.Fc = jt.friction.Fo = jt.friction.Fva = jt.friction.Fca = 0.0;
   }
   Workspace ws(rigid);
   Eigen::VectorXd tau(n);

@@ -762,12 +762,16 @@ Model identified_model(const Model& nominal, const std::vector<std::string>& nam
     int k = 0;
     if (options.layout.armature) f.Ia = c[k++];
     const int repeat = options.layout.asymmetric ? 2 : 1;
+    // Asymmetric pairs (positive, negative) become mean and asymmetry, which joint_torque()
+    // turns back into the sign-dependent law of seed 2 eq. 2.
     if (options.layout.viscous) {
       f.Fv = repeat == 2 ? 0.5 * (c[k] + c[k + 1]) : c[k];
+      f.Fva = repeat == 2 ? 0.5 * (c[k] - c[k + 1]) : 0.0;
       k += repeat;
     }
     if (options.layout.coulomb) {
       f.Fc = repeat == 2 ? 0.5 * (c[k] + c[k + 1]) : c[k];
+      f.Fca = repeat == 2 ? 0.5 * (c[k] - c[k + 1]) : 0.0;
       k += repeat;
     }
     if (options.layout.offset) f.Fo = c[k++];

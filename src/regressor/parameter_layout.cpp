@@ -49,10 +49,11 @@ Eigen::VectorXd ParameterLayout::parameters(const Model& model) const {
     const JointFriction& f = model.joints[j].friction;
     if (armature) theta[c++] = f.Ia;
     const int repeat = asymmetric ? 2 : 1;
+    // Asymmetric pairs are (positive, negative) = mean ± asymmetry (seed 2 eq. 2).
     if (viscous)
-      for (int r = 0; r < repeat; ++r) theta[c++] = f.Fv;
+      for (int r = 0; r < repeat; ++r) theta[c++] = f.Fv + (asymmetric ? (r ? -f.Fva : f.Fva) : 0);
     if (coulomb)
-      for (int r = 0; r < repeat; ++r) theta[c++] = f.Fc;
+      for (int r = 0; r < repeat; ++r) theta[c++] = f.Fc + (asymmetric ? (r ? -f.Fca : f.Fca) : 0);
     if (offset) theta[c++] = f.Fo;
   }
   return theta;

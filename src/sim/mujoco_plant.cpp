@@ -69,7 +69,9 @@ class MujocoPlant final : public Plant {
         dt_(dt),
         q_(Eigen::VectorXd::Zero(n_)),
         dq_(Eigen::VectorXd::Zero(n_)),
-        offset_(n_) {
+        offset_(n_),
+        asymmetry_v_(n_),
+        asymmetry_c_(n_) {
     install_mujoco_handlers();
     UrdfWriteOptions urdf_options;
     urdf_options.mujoco_compiler_tag = true;
@@ -113,6 +115,8 @@ class MujocoPlant final : public Plant {
       m_->dof_damping[dof_[j]] = joint.friction.Fv;
       m_->dof_frictionloss[dof_[j]] = options.coulomb ? joint.friction.Fc : 0.0;
       offset_[j] = joint.friction.Fo;
+      asymmetry_v_[j] = joint.friction.Fva;
+      asymmetry_c_[j] = options.coulomb ? joint.friction.Fca : 0.0;
       // MuJoCo's frictionloss is a soft constraint: with the default solref (0.02 s) and solimp
       // (0.9–0.95) a light joint (wrist) sees a force proportional to its speed well before Fc,
       // i.e. viscous friction, and identification then finds Fc ≈ 0. The stiffest settings the
@@ -173,15 +177,21 @@ class MujocoPlant final : public Plant {
   }
 
  private:
-  // Joint torque tau minus the constant offset Fo (MuJoCo has no such term).
+  // Joint torque tau minus the constant offset Fo and the friction asymmetry Fva·|dq| +
+  // Fca·|sign dq| (seed 2 eq. 2), which MuJoCo has no term for; the sign is smoothed as in the
+  // native plant (tanh(dq/v_s), v_s = 0.01 rad/s) and taken at the start of the step.
   void apply(const Eigen::Ref<const Eigen::VectorXd>& tau) {
     check_torque(n_, tau);
-    for (int j = 0; j < n_; ++j) d_->qfrc_applied[dof_[j]] = tau[j] - offset_[j];
+    for (int j = 0; j < n_; ++j) {
+      const double v = d_->qvel[dof_[j]];
+      d_->qfrc_applied[dof_[j]] = tau[j] - offset_[j] - asymmetry_v_[j] * std::abs(v) -
+                                  asymmetry_c_[j] * std::abs(std::tanh(v / 1e-2));
+    }
   }
 
   int n_;
   double dt_;
-  Eigen::VectorXd q_, dq_, offset_;
+  Eigen::VectorXd q_, dq_, offset_, asymmetry_v_, asymmetry_c_;
   std::vector<int> qpos_, dof_;
   std::unique_ptr<mjModel, ModelDeleter> m_;
   std::unique_ptr<mjData, DataDeleter> d_;

@@ -15,7 +15,7 @@ void plant_friction_torque(const Model& model, const PlantFrictionOptions& optio
   for (int j = 0; j < n; ++j) {
     const JointFriction& f = model.joints[j].friction;
     double tau = 0.0;
-    if (options.viscous) tau += f.Fv * dq[j];
+    if (options.viscous) tau += f.Fv * dq[j] + f.Fva * std::abs(dq[j]);
     if (options.coulomb) {
       // F = (Fc + (Fs − Fc)·exp(−(dq/v_st)²))·tanh(dq/v_s) (Stribeck curve with tanh smoothing).
       double level = f.Fc;
@@ -23,7 +23,8 @@ void plant_friction_torque(const Model& model, const PlantFrictionOptions& optio
         const double r = dq[j] / options.stribeck_velocity;
         level += (options.stiction[j] - f.Fc) * std::exp(-r * r);
       }
-      tau += level * std::tanh(dq[j] / options.smoothing_velocity);
+      const double smooth_sign = std::tanh(dq[j] / options.smoothing_velocity);
+      tau += level * smooth_sign + f.Fca * std::abs(smooth_sign);
     }
     if (options.offset) tau += f.Fo;
     out[j] = tau;
@@ -49,9 +50,9 @@ void check_plant_friction(const Model& model, const PlantFrictionOptions& option
 
 double plant_friction_max_slope(const JointFriction& friction, const PlantFrictionOptions& options,
                                 int joint) {
-  double slope = options.viscous ? std::abs(friction.Fv) : 0.0;
+  double slope = options.viscous ? std::abs(friction.Fv) + std::abs(friction.Fva) : 0.0;
   if (options.coulomb) {
-    slope += std::abs(friction.Fc) / options.smoothing_velocity;
+    slope += (std::abs(friction.Fc) + std::abs(friction.Fca)) / options.smoothing_velocity;
     if (options.stiction.size() > joint) {
       const double bump = std::abs(options.stiction[joint] - friction.Fc);
       slope += bump * (1.0 / options.smoothing_velocity +

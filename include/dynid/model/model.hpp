@@ -22,12 +22,16 @@ inline constexpr int kMaxJoints = 5000;
 /// XX XY XZ YY YZ ZZ MX MY MZ M (kg·m², kg·m, kg). MX = m·c_x.
 using LinkParams = Eigen::Matrix<double, kLinkParams, 1>;
 
-/// Joint-side actuator and friction terms: tau += Ia·ddq + Fv·dq + Fc·sign(dq) + Fo.
+/// Joint-side actuator and friction terms:
+/// tau += Ia·ddq + Fv·dq + Fc·sign(dq) + Fo + Fva·|dq| + Fca·|sign(dq)|.
+/// The last two are seed 2 eq. 2's asymmetry: Fvp,n = Fv ± Fva and Fcp,n = Fc ± Fca.
 struct JointFriction {
-  double Ia = 0.0;  ///< actuator (rotor) inertia reflected to the joint [kg·m² or kg]
-  double Fv = 0.0;  ///< viscous coefficient [N·m·s/rad or N·s/m]
-  double Fc = 0.0;  ///< Coulomb level [N·m or N]
-  double Fo = 0.0;  ///< constant offset [N·m or N]
+  double Ia = 0.0;   ///< actuator (rotor) inertia reflected to the joint [kg·m² or kg]
+  double Fv = 0.0;   ///< viscous coefficient, mean of both directions [N·m·s/rad or N·s/m]
+  double Fc = 0.0;   ///< Coulomb level, mean of both directions [N·m or N]
+  double Fo = 0.0;   ///< constant offset [N·m or N]
+  double Fva = 0.0;  ///< viscous asymmetry (Fvp − Fvn)/2 [N·m·s/rad or N·s/m]
+  double Fca = 0.0;  ///< Coulomb asymmetry (Fcp − Fcn)/2 [N·m or N]
 };
 
 /// Joint limits; absent limits are +/- infinity.
