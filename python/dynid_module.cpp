@@ -14,6 +14,7 @@
 #include "dynid/common/error.hpp"
 #include "dynid/dynamics/rnea.hpp"
 #include "dynid/estimation/identification.hpp"
+#include "dynid/estimation/load_identification.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
 #include "dynid/io/atomic_file.hpp"
 #include "dynid/io/model_summary.hpp"
@@ -21,6 +22,7 @@
 #include "dynid/model/robots.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
 #include "dynid/report/identification_report.hpp"
+#include "dynid/report/payload_report.hpp"
 #include "dynid/version.hpp"
 
 namespace py = pybind11;
@@ -133,6 +135,130 @@ IdentifyOptions identify_options(const py::kwargs& kw, nlohmann::json& used) {
   o.signal.filter = get("filter", true);
   o.signal.decimate = get("decimate", 0);
   return o;
+}
+
+// payload() of a wrist force/torque sensor on the robot, as `dynid payload --robot R
+// --sensor-link L`: the same stages and the same JSON (payload_to_json).
+nlohmann::json payload(const Model& model, const std::string& sensor_link,
+                       const std::optional<Eigen::VectorXd>& t, const Samples& q,
+                       const Samples& wrench, const std::optional<RowMatrix>& dq,
+                       const std::optional<RowMatrix>& ddq, const py::kwargs& kw) {
+  static const char* kKeys[] = {"sensor_pose", "model",      "interval",  "bias",  "wrench_sign",
+                                "estimator",   "confidence", "cutoff_hz", "filter"};
+  std::string valid;
+  for (const char* k : kKeys) valid += (valid.empty() ? "" : ", ") + std::string(k);
+  for (const auto& item : kw) {
+    const std::string key = py::str(item.first);
+    if (std::find_if(std::begin(kKeys), std::end(kKeys), [&](const char* k) { return key == k; }) ==
+        std::end(kKeys)) {
+      throw py::type_error("unknown option '" + key + "'; valid options are " + valid);
+    }
+  }
+  auto get = [&](const char* key, auto fallback) {
+    using T = decltype(fallback);
+    return kw.contains(key) ? kw[key].cast<T>() : fallback;
+  };
+  LoadEquationOptions equations;
+  const std::string kind = get("model", std::string("differential"));
+  if (kind == "differential") {
+    equations.model = LoadModelKind::kDifferential;
+  } else if (kind == "integral") {
+    equations.model = LoadModelKind::kIntegral;
+  } else if (kind == "static") {
+    equations.model = LoadModelKind::kStatic;
+  } else {
+    throw py::value_error("model must be 'differential', 'integral' or 'static', not '" + kind +
+                          "'");
+  }
+  equations.interval = get("interval", 0.2);
+  if (!(equations.interval > 0.0)) throw py::value_error("interval must be a positive window [s]");
+  equations.bias = get("bias", false);
+  equations.wrench_sign = get("wrench_sign", 1.0);
+  if (!(equations.wrench_sign == 1.0 || equations.wrench_sign == -1.0)) {
+    throw py::value_error(
+        "wrench_sign must be 1 (force of the load on the sensor) or -1 (of the sensor on the "
+        "load)");
+  }
+  LoadIdentificationOptions options;
+  const std::string estimator = get("estimator", std::string("ols"));
+  if (estimator == "ols") {
+    options.estimator = LoadEstimator::kOls;
+  } else if (estimator == "wls") {
+    options.estimator = LoadEstimator::kWls;
+  } else if (estimator == "rls") {
+    options.estimator = LoadEstimator::kRls;
+  } else {
+    throw py::value_error("estimator must be 'ols', 'wls' or 'rls', not '" + estimator + "'");
+  }
+  options.confidence_level = get("confidence", 0.999);
+  if (!(options.confidence_level > 0.0 && options.confidence_level < 1.0))
+    throw py::value_error("confidence must be in (0, 1), e.g. 0.999");
+  SensorMount mount;
+  mount.link = find_link(model, sensor_link);
+  if (kw.contains("sensor_pose")) {
+    const auto pose = kw["sensor_pose"].cast<std::vector<double>>();
+    if (pose.size() != 6) {
+      throw py::value_error("sensor_pose must be [x, y, z, roll, pitch, yaw] [m, rad]");
+    }
+    mount.p_LS = Eigen::Vector3d(pose[0], pose[1], pose[2]);
+    mount.R_LS = roll_pitch_yaw(pose[3], pose[4], pose[5]);
+  }
+  const bool standing = equations.model == LoadModelKind::kStatic;
+  if (!standing && !t) throw py::value_error("t is required unless model='static'");
+  const RowMatrix::Index rows = q.rows();
+  if (t && t->size() != rows) {
+    throw Error("t has " + std::to_string(t->size()) + " samples, q " + std::to_string(rows));
+  }
+  check_samples(model, "q", rows, q);
+  if (wrench.rows() != rows || wrench.cols() != 6) {
+    throw Error("wrench must be " + std::to_string(rows) +
+                " x 6 (fx fy fz mx my mz [N, N m] in the sensor frame), not " +
+                std::to_string(wrench.rows()) + " x " + std::to_string(wrench.cols()));
+  }
+  if (!wrench.allFinite()) throw Error("wrench holds NaN or Inf");
+  JointRecord record;
+  if (t) record.t = *t;
+  record.q = q;
+  if (dq) {
+    check_samples(model, "dq", rows, *dq);
+    record.dq = *dq;
+  }
+  if (ddq) {
+    check_samples(model, "ddq", rows, *ddq);
+    record.ddq = *ddq;
+  }
+  std::vector<std::pair<std::string, std::string>> choices;
+  SensorMotion motion;
+  Eigen::MatrixXd w = wrench;
+  if (standing) {
+    record.dq.resize(0, 0);
+    record.ddq.resize(0, 0);
+    motion = sensor_motion_from_joints(model, record, mount);
+  } else {
+    SignalOptions signal;
+    signal.filter = get("filter", true);
+    signal.cutoff_hz = get("cutoff_hz", 0.0);
+    PreparedLoadRun run = prepare_load_run(record, w, signal, choices);
+    // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
+    options.hac_covariance = signal.filter;
+    w = std::move(run.wrench);
+    motion = sensor_motion_from_joints(model, run.record, mount);
+  }
+  const EquationBlock block = load_equations(motion, w, equations);
+  LoadIdentificationResult r;
+  {
+    py::gil_scoped_release release;
+    r = identify_load(block, options);
+  }
+  PayloadJsonContext context;
+  context.model = kind;
+  context.frame = {{"robot", model.name}, {"sensor_link", model.joints[mount.link].link_name}};
+  context.extra = {{"wrench_sign", equations.wrench_sign}};
+  if (equations.model == LoadModelKind::kIntegral) context.extra["interval"] = equations.interval;
+  context.group_names = block.group_names;
+  context.with_inertia = !standing;
+  context.choices = choices;
+  return payload_to_json(r, context);
 }
 
 }  // namespace
@@ -274,6 +400,27 @@ PYBIND11_MODULE(dynid, m) {
       py::arg("dq") = py::none(), py::arg("ddq") = py::none(),
       "Prediction errors of an identify() result on another run, as 'dynid validate': give the "
       "same options as to identify(). Returns a dict with the keys of the validate JSON.");
+
+  m.def(
+      "payload",
+      [](const Model& model, const std::string& sensor_link,
+         const std::optional<Eigen::VectorXd>& t, const Samples& q, const Samples& wrench,
+         const std::optional<RowMatrix>& dq, const std::optional<RowMatrix>& ddq,
+         const py::kwargs& kw) {
+        return to_python(payload(model, sensor_link, t, q, wrench, dq, ddq, kw));
+      },
+      py::arg("model"), py::arg("sensor_link"), py::arg("t"), py::arg("q"), py::arg("wrench"),
+      py::arg("dq") = py::none(), py::arg("ddq") = py::none(),
+      "Inertial parameters of a gripped load from a wrist force/torque sensor, as 'dynid payload "
+      "--robot R --sensor-link L' (Dutkiewicz, Kozlowski, Wroblewski 1993): sensor_link names "
+      "the link (or joint) that carries the sensor; t (m,) [s] (None with model='static'), q "
+      "(m x n), wrench (m x 6: fx fy fz mx my mz [N, N m], the force of the load on the sensor, "
+      "sensor frame), optional dq, ddq. Options: sensor_pose [x, y, z, roll, pitch, yaw] of the "
+      "sensor in the link frame [m, rad], model ('differential', 'integral', 'static'), interval "
+      "(integral window [s], 0.2), bias (bool: sensor offsets), wrench_sign (1 or -1), estimator "
+      "('ols', 'wls', 'rls'), confidence (0.999), cutoff_hz (0 = automatic), filter (bool). "
+      "Returns a dict with the keys of the payload JSON (parameters, mass, com, inertia_com, "
+      "physically_consistent, ...).");
 
   m.def(
       "export_urdf",

@@ -639,6 +639,7 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
       warn(std::string("no torque plot in the result: ") + e.what());
     }
     if (result.history_x.rows() > 0) out["plot"]["history"] = rls_history_plot_json(result);
+    if (o.model == "integral") out["plot"]["energy"] = energy_plot_json(model, result, options);
   }
   if (o.physical) {
     if (!result.not_excited.empty()) {

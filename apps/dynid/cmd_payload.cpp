@@ -23,6 +23,7 @@
 #include "dynid/io/json_writer.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/report/html_report.hpp"
+#include "dynid/report/payload_report.hpp"
 #include "dynid/version.hpp"
 #include "flag_checks.hpp"
 #include "result_options.hpp"
@@ -54,22 +55,6 @@ Eigen::MatrixXd optional_columns(const CsvTable& table, const std::vector<std::s
   return x;
 }
 
-nlohmann::json parameter_json(const LoadIdentificationResult& r) {
-  nlohmann::json list = nlohmann::json::array();
-  const Estimate& e = r.estimate;
-  for (std::size_t j = 0; j < r.names.size(); ++j) {
-    const auto i = static_cast<Eigen::Index>(j);
-    list.push_back({{"name", r.names[j]},
-                    // A parameter the data do not determine has no value worth a number.
-                    {"value", std::isfinite(e.std_dev(i)) ? json_number(e.x(i)) : nlohmann::json()},
-                    {"std", json_number(e.std_dev(i))},
-                    {"relative_std_percent", json_number(e.relative_std_percent(i))},
-                    {"ci_low", json_number(e.ci_lower(i))},
-                    {"ci_high", json_number(e.ci_upper(i))}});
-  }
-  return list;
-}
-
 // The result JSON (docs/cli.md, `dynid payload`), the echo on stderr, the RLS history.
 void write_result(const PayloadCliOptions& cli, const LoadIdentificationResult& r,
                   const char* model_name, const nlohmann::json& frame, const nlohmann::json& extra,
@@ -78,50 +63,8 @@ void write_result(const PayloadCliOptions& cli, const LoadIdentificationResult& 
   const Estimate& e = r.estimate;
   const bool mass_known =
       std::find(r.not_excited.begin(), r.not_excited.end(), "m") == r.not_excited.end();
-  nlohmann::json out = {
-      {"command", "payload"},
-      {"model", model_name},
-      {"estimator", to_string(e.summary.estimator)},
-      {"frame", frame},
-      {"confidence_level", e.confidence_level},
-      {"covariance", e.covariance_kind},
-      {"parameters", parameter_json(r)},
-      {"mass", mass_known ? json_number(e.x(0)) : nlohmann::json()},
-      {"com", r.physics.mass > 0.0
-                  ? nlohmann::json{json_number(r.physics.com.x()), json_number(r.physics.com.y()),
-                                   json_number(r.physics.com.z())}
-                  : nlohmann::json()},
-      {"physically_consistent", r.physics.consistent},
-      {"consistency_violation", r.physics.violated},
-      {"not_excited", r.not_excited},
-      {"residual_rms", json_number(e.residual_rms)},
-      {"relative_error", json_number(e.relative_error)},
-      {"condition_number", json_number(e.summary.condition_number)},
-      {"rows", e.summary.rows},
-      {"warnings", e.summary.warnings},
-      {"version", kVersion}};
-  out.update(extra);
-  if (with_inertia && r.physics.mass > 0.0) {
-    const Eigen::Matrix3d& I = r.physics.inertia_com;
-    out["inertia_com"] = {{"Ixx", I(0, 0)}, {"Ixy", I(0, 1)}, {"Ixz", I(0, 2)},
-                          {"Iyy", I(1, 1)}, {"Iyz", I(1, 2)}, {"Izz", I(2, 2)}};
-  } else {
-    out["inertia_com"] = nullptr;
-    if (!with_inertia) {
-      out["not_reported"] =
-          "inertias: standing poses determine only the mass, the first moments "
-          "and the offsets";
-    }
-  }
-  nlohmann::json per_component = nlohmann::json::object();
-  for (std::size_t c = 0; c < group_names.size(); ++c) {
-    per_component[group_names[c]] =
-        json_number(e.group_rms.size() ? e.group_rms(static_cast<Eigen::Index>(c)) : NAN);
-  }
-  out["residual_rms_per_component"] = per_component;
-  nlohmann::json choice_json = nlohmann::json::object();
-  for (const auto& [key, value] : choices) choice_json[key] = value;
-  out["choices"] = choice_json;
+  const nlohmann::json out =
+      payload_to_json(r, {model_name, frame, extra, group_names, with_inertia, choices});
   for (const auto& [key, value] : choices) {
     std::cerr << "payload: " << key << ": " << one_line(value) << '\n';
   }

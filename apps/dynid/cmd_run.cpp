@@ -8,6 +8,7 @@
 
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
+#include "dynid/common/progress.hpp"
 #include "dynid/workflow/project.hpp"
 
 namespace dynid::cli {
@@ -15,6 +16,7 @@ namespace {
 
 struct RunCliOptions {
   std::string project, out;
+  bool quiet = false;
 };
 
 CommandTable command_table() {
@@ -52,8 +54,15 @@ void run(const RunCliOptions& c) {
   ProjectOptions o;
   o.project_file = c.project;
   o.output = c.out;
-  const ProjectResult r =
-      run_project(o, command_table(), [](const std::string& line) { std::cerr << line << '\n'; });
+  // One counting line per stage, ended: the stages print their own lines on stderr, which a line
+  // redrawn in place would run into.
+  ProgressCallback progress;
+  if (progress_wanted(c.quiet)) {
+    progress = [](double fraction, const std::string& what) {
+      std::cerr << "run: " << static_cast<int>(100.0 * fraction) << " % " << what << std::endl;
+    };
+  }
+  const ProjectResult r = run_project(o, command_table(), progress);
   std::cout << "study written to " << r.output_dir << " (" << r.commands.size()
             << " stages; the project file and commands.txt beside the results)\n";
 }
@@ -69,6 +78,8 @@ void add_run_command(CLI::App& app) {
       "written into the output folder with the project file copied beside it (docs/cli.md)");
   cmd->add_option("project", c->project, "Project YAML file")->required();
   cmd->add_option("--out,-o", c->out, "Output folder instead of the project's output: key");
+  cmd->add_flag("--quiet,-q", c->quiet,
+                "No progress line on stderr (shown only when stderr is a terminal)");
   cmd->callback([c] { run(*c); });
 }
 

@@ -115,3 +115,54 @@ def test_bad_input_raises_with_a_message(planar2):
     nan = np.full((1, 2), np.nan)
     with pytest.raises(dynid.Error, match="NaN"):
         dynid.inverse_dynamics(planar2, nan, nan, nan)
+
+
+def sensor_wrench(q, dq, ddq, m, c, inertia_c):
+    """Force and moment a rigid load exerts on a sensor in the forearm frame of planar2, by
+    Newton-Euler of the load itself (not dynid's load regressor): f = m (g - a_c),
+    n = -(I_c w' + w x I_c w) + c x f, all in the sensor frame (MDH: elbow at (cos q1, sin q1),
+    frame rotated by q1 + q2 about z)."""
+    th = q[:, 0] + q[:, 1]
+    a_elbow = np.column_stack([-np.sin(q[:, 0]) * ddq[:, 0] - np.cos(q[:, 0]) * dq[:, 0] ** 2,
+                               np.cos(q[:, 0]) * ddq[:, 0] - np.sin(q[:, 0]) * dq[:, 0] ** 2,
+                               np.zeros(len(q))])
+    out = np.zeros((len(q), 6))
+    for k in range(len(q)):
+        ct, st = np.cos(th[k]), np.sin(th[k])
+        r = np.array([[ct, -st, 0.0], [st, ct, 0.0], [0.0, 0.0, 1.0]])  # sensor in world
+        w = np.array([0.0, 0.0, dq[k, 0] + dq[k, 1]])
+        dw = np.array([0.0, 0.0, ddq[k, 0] + ddq[k, 1]])
+        a_c = r.T @ a_elbow[k] + np.cross(dw, c) + np.cross(w, np.cross(w, c))
+        g = r.T @ np.array([0.0, -G, 0.0])
+        f = m * (g - a_c)
+        n = -(inertia_c @ dw + np.cross(w, inertia_c @ w)) + np.cross(c, f)
+        out[k] = np.concatenate([f, n])
+    return out
+
+
+def test_payload_recovers_a_load_on_the_forearm_within_its_intervals(planar2):
+    t, q, dq, ddq = fourier_run(8, samples=2000)
+    m, c = 0.8, np.array([0.05, -0.02, 0.03])
+    inertia_c = np.diag([2e-3, 3e-3, 4e-3])
+    rng = np.random.default_rng(9)
+    wrench = sensor_wrench(q, dq, ddq, m, c, inertia_c) + rng.normal(0.0, 0.05, size=(len(t), 6))
+    result = dynid.payload(planar2, "forearm", t, q, wrench, dq=dq, ddq=ddq, filter=False)
+    # The keys of `dynid payload`'s JSON (payload_to_json, shared with the command line).
+    for key in ("command", "model", "frame", "parameters", "mass", "com", "inertia_com",
+                "physically_consistent", "not_excited", "residual_rms", "condition_number",
+                "residual_rms_per_component", "choices", "version"):
+        assert key in result, key
+    assert result["command"] == "payload" and result["frame"]["sensor_link"] == "forearm"
+    # Inertias about the sensor origin: I_O = I_c + m (|c|^2 1 - c c^T) (parallel axes).
+    inertia_o = inertia_c + m * (c @ c * np.eye(3) - np.outer(c, c))
+    truth = {"m": m, "mcx": m * c[0], "mcy": m * c[1], "mcz": m * c[2], "Ixz": inertia_o[0, 2],
+             "Iyz": inertia_o[1, 2], "Izz": inertia_o[2, 2]}
+    values = {p["name"]: p for p in result["parameters"]}
+    for name, x in truth.items():
+        assert values[name]["ci_low"] <= x <= values[name]["ci_high"], (values[name], x)
+    # Planar motion turns the load about z only: Ixx, Iyy and the products are not all excited.
+    assert sorted(result["not_excited"]) == ["Ixx", "Ixy", "Iyy"]
+    with pytest.raises(TypeError, match="valid options are sensor_pose"):
+        dynid.payload(planar2, "forearm", t, q, wrench, speed=1)
+    with pytest.raises(dynid.Error, match="wrench must be"):
+        dynid.payload(planar2, "forearm", t, q, wrench[:, :5])

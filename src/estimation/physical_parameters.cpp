@@ -156,6 +156,33 @@ struct PriorCost {
   }
 };
 
+// Ends the solve successfully once the cost has stalled: less than `tolerance`·cost gained over
+// the last `window` iterations (PhysicalFitOptions::stall_tolerance). Ceres' own function
+// tolerance looks at one step, and single steps in the valley vary by orders of magnitude.
+class StallCallback : public ceres::IterationCallback {
+ public:
+  StallCallback(double tolerance, int window) : tolerance_(tolerance), window_(window) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    costs_.push_back(summary.cost);
+    const size_t k = costs_.size();
+    if (window_ <= 0 || k <= static_cast<size_t>(window_)) return ceres::SOLVER_CONTINUE;
+    // A rise over the window is a non-monotone excursion, not a stall: let it play out.
+    const double gain = costs_[k - 1 - static_cast<size_t>(window_)] - costs_[k - 1];
+    if (gain >= 0.0 && gain < tolerance_ * costs_[k - 1]) {
+      stalled_ = true;
+      return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+    }
+    return ceres::SOLVER_CONTINUE;
+  }
+  bool stalled() const { return stalled_; }
+
+ private:
+  double tolerance_;
+  int window_;
+  bool stalled_ = false;
+  std::vector<double> costs_;
+};
+
 }  // namespace
 
 PhysicalFit physical_parameters(const Model& nominal, const BaseParameters& base,
@@ -255,6 +282,8 @@ PhysicalFit physical_parameters(const Model& nominal, const BaseParameters& base
   // The data fix only the base combinations; along the rest the cost is the weak prior, a long
   // flat valley in which monotone steps crawl.
   so.use_nonmonotonic_steps = true;
+  StallCallback stall(options.stall_tolerance, options.stall_window);
+  so.callbacks.push_back(&stall);
   ceres::Solver::Summary cs;
   ceres::Solve(so, &problem, &cs);
 
@@ -286,7 +315,7 @@ PhysicalFit physical_parameters(const Model& nominal, const BaseParameters& base
     out.consistent = out.consistent && out.min_pseudo_inertia_eigenvalue[l] >= -1e-12 * scale;
   }
   out.iterations = static_cast<int>(cs.iterations.size());
-  out.converged = cs.termination_type == ceres::CONVERGENCE;
+  out.converged = cs.termination_type == ceres::CONVERGENCE || stall.stalled();
   if (out.mahalanobis > out.chi2_limit) {
     std::ostringstream m;
     m.precision(3);

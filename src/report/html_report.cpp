@@ -7,6 +7,8 @@
 #include <sstream>
 
 #include "dynid/common/error.hpp"
+#include "dynid/estimation/integral_equations.hpp"
+#include "dynid/estimation/pipeline.hpp"
 #include "dynid/excitation/fourier_trajectory.hpp"
 #include "dynid/io/atomic_file.hpp"
 #include "dynid/sim/error_statistics.hpp"
@@ -469,13 +471,71 @@ Json excite_section(const ReportInput& in) {
                            {"labels", labels},
                            {"series", spectra}});
   }
+  // Only limits that bound something: an unbounded limit's margin is infinite (null in the JSON)
+  // and would only flatten the others.
   std::vector<std::string> names;
   Json margins = Json::array();
   for (const auto& m : r.value("margins", Json::array())) {
+    const double margin = number_or_nan(m.value("margin", Json()));
+    if (!std::isfinite(margin)) continue;
     names.push_back(text_of(m.value("name", Json("?"))));
-    margins.push_back(m.value("margin", Json()));
+    margins.push_back(rounded(margin, 6));
   }
-  add_joint_bars(margins, names, "Constraint margins (negative: violated)", "margin", s);
+  add_joint_bars(margins, names, "Constraint margins of the finite limits (negative: violated)",
+                 "margin", s);
+  return s;
+}
+
+// `dynid compare-control` (seed 2 §3.6, Fig. 9): per joint, each controller's tracking error
+// after the first period — RMS, peak, peak near a velocity reversal — side by side.
+Json control_section(const ReportInput& in) {
+  const Json& r = in.result;
+  Json s = new_section(in, "compare-control",
+                       "Controller comparison: tracking errors under the same reference");
+  add_fact(s, "samples (after the first period)", text_of(r.value("samples", Json())));
+  add_fact(s, "reversal window [s]", text_of(r.value("reversal_window", Json())));
+  const Json& controllers = r.value("controllers", Json::array());
+  Json labels = Json::array();
+  if (!controllers.empty()) {
+    for (const auto& j : controllers[0].value("joints", Json::array()))
+      labels.push_back(text_of(j.value("name", Json("?"))));
+  }
+  const std::pair<const char*, const char*> metrics[] = {
+      {"rms", "Tracking error RMS per joint"},
+      {"max", "Largest tracking error per joint"},
+      {"max_at_reversal", "Largest tracking error near a velocity reversal per joint"}};
+  for (const auto& [key, title] : metrics) {
+    Json list = Json::array();
+    for (const auto& c : controllers) {
+      Json ys = Json::array();
+      for (const auto& j : c.value("joints", Json::array()))
+        ys.push_back(rounded(number_or_nan(j.value(key, Json())), 6));
+      list.push_back({{"label", text_of(c.value("name", Json("?")))}, {"y", ys}, {"kind", "bar"}});
+    }
+    if (list.empty() || labels.empty()) continue;
+    s["charts"].push_back({{"title", title},
+                           {"type", "bar"},
+                           {"y_label", "|qr − q| [rad or m]"},
+                           {"labels", labels},
+                           {"series", list}});
+  }
+  if (controllers.size() >= 2) {
+    // The ratio the comparison is about: how much of the PID's error the model removes.
+    Json rows = Json::array();
+    const Json& first = controllers[0].value("joints", Json::array());
+    const Json& second = controllers[1].value("joints", Json::array());
+    for (size_t j = 0; j < first.size() && j < second.size(); ++j) {
+      const double a = number_or_nan(first[j].value("max", Json()));
+      const double b = number_or_nan(second[j].value("max", Json()));
+      rows.push_back({text_of(first[j].value("name", Json("?"))), text_of(rounded(a, 4)),
+                      text_of(rounded(b, 4)), a > 0.0 ? text_of(rounded(b / a, 3)) : "n/a"});
+    }
+    s["tables"].push_back({{"title", "Peak tracking error"},
+                           {"columns",
+                            {"joint", text_of(controllers[0].value("name", Json("?"))),
+                             text_of(controllers[1].value("name", Json("?"))), "ratio"}},
+                           {"rows", rows}});
+  }
   return s;
 }
 
@@ -707,6 +767,7 @@ std::string result_kind(const nlohmann::json& r) {
   if (r.value("command", Json()) == "payload") return "payload";
   if (r.contains("criterion") && r.contains("coefficients")) return "excite";
   if (r.contains("channels") && r.contains("periods")) return "average";
+  if (r.contains("controllers") && r["controllers"].is_array()) return "compare-control";
   if (r.contains("joints") && r["joints"].is_array() && !r["joints"].empty() &&
       r["joints"][0].is_object()) {
     if (r["joints"][0].contains("position")) return "validate-simulation";
@@ -760,6 +821,8 @@ std::string html_report(const std::vector<ReportInput>& inputs, const HtmlReport
         section = average_section(in);
       else if (kind == "excite")
         section = excite_section(in);
+      else if (kind == "compare-control")
+        section = control_section(in);
       else if (kind == "experiment")
         section = experiment_section(in, in.result["options"]["model"]);
       else
@@ -889,6 +952,32 @@ nlohmann::json rls_history_plot_json(const IdentificationResult& r,
         {{"name", r.names[static_cast<size_t>(c)]}, {"value", value}, {"std", std_dev}});
   }
   return {{"t", ts}, {"parameters", params}};
+}
+
+nlohmann::json energy_plot_json(const Model& model, const IdentificationResult& result,
+                                const IdentifyOptions& options,
+                                const PredictionPlotOptions& plot_options) {
+  if (!result.estimate.x.allFinite()) return nullptr;
+  IntegralOptions integral = options.integral;
+  // Joules on both sides: the row weights only balance the estimator.
+  integral.weighting = IntegralWeighting::kNone;
+  const bool coupling =
+      static_cast<int>(result.base.layout_names.size()) > options.layout.columns(model.dof());
+  const EquationBlock block = select_base_columns(
+      integral_equations(model, options.layout, coupling, result.processed, integral), result.base);
+  const Eigen::VectorXd predicted = block.W * result.estimate.x;
+  const auto keep = display_indices(block.y.size(), plot_options.max_points);
+  const int digits = plot_options.significant_digits;
+  Json ts = Json::array(), measured = Json::array(), pred = Json::array();
+  for (Eigen::Index i : keep) {
+    ts.push_back(rounded(block.t(i), 8));
+    measured.push_back(rounded(block.y(i), digits));
+    pred.push_back(rounded(predicted(i), digits));
+  }
+  return {{"t", ts},
+          {"measured", measured},
+          {"predicted", pred},
+          {"decimated_every", keep.size() > 1 ? keep[1] - keep[0] : 1}};
 }
 
 }  // namespace dynid

@@ -75,7 +75,8 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
       ex.q_max = ex.q_max.size() ? ex.q_max : Eigen::VectorXd::Constant(n, 2.5);
     }
   }
-  ex.tau_max = Eigen::VectorXd::Constant(n, 1e6);
+  // No torque limit beyond the model's (none for puma560): an unbounded limit has no margin to
+  // report, where a stand-in like 1e6 N·m dwarfed the real margins in the report's chart.
   out.excitation = optimize_excitation(model, ex);
   write_json(file("excitation.json"), excitation_to_json(out.excitation));
   const TrajectorySamples traj =

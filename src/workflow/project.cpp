@@ -220,7 +220,7 @@ void in_folder(const fs::path& dir, const fs::path& log, Body&& body) {
 }  // namespace
 
 ProjectResult run_project(const ProjectOptions& options, const CommandTable& table,
-                          const std::function<void(const std::string&)>& progress) {
+                          const ProgressCallback& progress) {
   const fs::path project = fs::absolute(options.project_file);
   const std::string where = project.filename().string();
   std::error_code ec;
@@ -340,8 +340,11 @@ ProjectResult run_project(const ProjectOptions& options, const CommandTable& tab
       }
       for (const auto& out : stage.outputs) args.insert(args.end(), {"--" + out.flag, out.file});
       args.insert(args.end(), plan[s].second.begin(), plan[s].second.end());
-      progress("[" + std::to_string(s + 1) + "/" + std::to_string(plan.size()) + "] dynid " +
-               join(args, " "));
+      if (progress) {
+        progress(static_cast<double>(s) / static_cast<double>(plan.size()),
+                 "stage " + std::to_string(s + 1) + "/" + std::to_string(plan.size()) + ": dynid " +
+                     join(args, " "));
+      }
       try {
         in_folder(partial, stage.command + ".txt", [&] { table.run(args); });
       } catch (const UsageError& e) {

@@ -1,5 +1,6 @@
 // `dynid report` and the --report flags end to end: every result kind dynid writes becomes a page
 // that headless Chromium renders without a script error and with points in every chart.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -104,6 +105,90 @@ TEST_F(ReportCli, EveryResultKindRendersInChromium) {
   r = run("report --in " + path("id.json") + " --out " + path("one.html"));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(testing::slurp(path("id.html")).size(), testing::slurp(path("one.html")).size());
+}
+
+// The kinds that come from simulated experiments, in one page (one Chromium start): the integral
+// model's energy fit (seed 1 Fig. 5), the gravity and friction experiments, validation by
+// simulation and the controller comparison. Native plant, short runs.
+TEST_F(ReportCli, ExperimentSimulationAndControlKindsRenderInChromium) {
+  // One 4 s period of two harmonics per joint at 200 Hz (as tests/cli/control_cli_test.cpp).
+  {
+    std::ofstream f(path("traj.csv"));
+    f << "t,q1,q2,dq1,dq2,ddq1,ddq2\n";
+    const double w = M_PI / 2;
+    for (int k = 0; k < 800; ++k) {
+      const double t = k / 200.0;
+      f << t << ',' << 0.6 * std::sin(w * t) + 0.2 * std::sin(3 * w * t + 1) << ','
+        << 0.4 * std::sin(2 * w * t) + 0.3 * std::cos(w * t) - 0.3 << ','
+        << 0.6 * w * std::cos(w * t) + 0.6 * w * std::cos(3 * w * t + 1) << ','
+        << 0.8 * w * std::cos(2 * w * t) - 0.3 * w * std::sin(w * t) << ','
+        << -0.6 * w * w * std::sin(w * t) - 1.8 * w * w * std::sin(3 * w * t + 1) << ','
+        << -1.6 * w * w * std::sin(2 * w * t) - 0.3 * w * w * std::cos(w * t) << '\n';
+    }
+  }
+  const std::string noise = " --engine native --torque-noise 0.02 --position-noise 1e-5";
+  auto r = run("simulate --robot planar2 --trajectory " + path("traj.csv") + " --out " +
+               path("pid.csv") + " --periods 3 --controller pid" + noise);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("identify -r planar2 -d " + path("pid.csv") + " --out " + path("id.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("identify -r planar2 --model integral -d " + path("pid.csv") + " --out " +
+          path("integral.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  // The energy section: measured work per interval against the fitted model's. Independent of
+  // the report: the model explains the measured work (a wrong column or sign would not).
+  const auto integral = nlohmann::json::parse(std::ifstream(path("integral.json")));
+  ASSERT_TRUE(integral["plot"]["energy"].is_object()) << integral["plot"].dump().substr(0, 300);
+  const auto& measured = integral["plot"]["energy"]["measured"];
+  const auto& predicted = integral["plot"]["energy"]["predicted"];
+  ASSERT_GT(measured.size(), 50u);
+  ASSERT_EQ(measured.size(), predicted.size());
+  ASSERT_EQ(measured.size(), integral["plot"]["energy"]["t"].size());
+  double e2 = 0.0, y2 = 0.0;
+  for (size_t i = 0; i < measured.size(); ++i) {
+    e2 += std::pow(measured[i].get<double>() - predicted[i].get<double>(), 2);
+    y2 += std::pow(measured[i].get<double>(), 2);
+  }
+  EXPECT_LT(std::sqrt(e2 / y2), 0.05) << "energy fit " << std::sqrt(e2 / y2);  // 0.003 measured
+  // Dedicated experiments: gravity of the elbow from slopes, friction of the shoulder from
+  // bang-bang moves (as tests/cli/identify_models_cli_test.cpp).
+  const std::pair<std::string, std::string> experiments[] = {
+      {"gravity",
+       "--family slope --joint 2 --range -1.2:1.2 --velocity 0.6 --acceleration 2 --pose 0.3,0 "
+       "--cycles 1"},
+      {"friction", "--family bang-bang --joint 1 --range -1:1 --acceleration 4 --pose 0,0.5"}};
+  const std::string joint[] = {"2", "1"};
+  for (int e = 0; e < 2; ++e) {
+    const std::string& name = experiments[e].first;
+    r = run("excite --robot planar2 " + experiments[e].second + " --rate 200 --out " +
+            path(name + "_ref.csv"));
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = run("simulate --robot planar2 --trajectory " + path(name + "_ref.csv") +
+            " --periods 2 --out " + path(name + ".csv") + noise);
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = run("identify --robot planar2 --model " + name + " --joint " + joint[e] + " --data " +
+            path(name + ".csv") + " --out " + path(name + ".json"));
+    ASSERT_EQ(r.code, 0) << r.err;
+  }
+  r = run("simulate --robot planar2 --trajectory " + path("traj.csv") + " --out " + path("ct.csv") +
+          " --periods 2 --controller computed-torque --params " + path("id.json") + noise);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("validate --mode simulation --robot planar2 --params " + path("id.json") + " --data " +
+          path("ct.csv") + " --trajectory " + path("traj.csv") + " --engine native --json " +
+          path("valsim.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("compare-control --robot planar2 --params " + path("id.json") + " --trajectory " +
+          path("traj.csv") + " --engine native --json " + path("cmp.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("report --in " + path("integral.json") + " --in " + path("gravity.json") + " --in " +
+          path("friction.json") + " --in " + path("valsim.json") + " --in " + path("cmp.json") +
+          " --out " + path("kinds.html"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string page = testing::slurp(path("kinds.html"));
+  EXPECT_NE(page.find("Energy over the intervals"), std::string::npos);
+  EXPECT_NE(page.find("Tracking error RMS per joint"), std::string::npos);
+  expect_renders(path("kinds.html"), {"identify", "experiment", "experiment", "validate-simulation",
+                                      "compare-control"});
 }
 
 TEST_F(ReportCli, BadInputsGiveOneErrorLineAndNoPage) {

@@ -28,7 +28,8 @@ struct ReportInput {
 };
 
 /// What a result JSON is, from the keys the commands write (docs/cli.md): identify (differential
-/// or integral), validate (torque), validate-simulation, payload, average, excite, experiment
+/// or integral), validate (torque), validate-simulation, payload, average, excite,
+/// compare-control, experiment
 /// (identify --model gravity|friction|decoupled); "generic" for anything else.
 std::string result_kind(const nlohmann::json& result);
 
@@ -41,7 +42,9 @@ ReportInput read_report_input(const std::string& path);
 /// intervals as error bars coloured by %σ, and the plots the input carries (`plot` of identify and
 /// validate: measured vs predicted torque, residual, residual histogram against the fitted
 /// Gaussian with its Kolmogorov–Smirnov test, seed 2 Figs. 5 and 8; RLS histories, seed 1 Figs. 6
-/// and 8; an excitation's trajectory and line spectrum; the fits of the dedicated experiments).
+/// and 8; the integral model's energy fit, seed 1 Fig. 5; an excitation's trajectory and line
+/// spectrum; the fits of the dedicated experiments; compare-control's tracking errors per
+/// controller and joint, seed 2 Fig. 9).
 /// Each chart reports itself to the page (body data-charts, data-points, data-empty-charts,
 /// data-errors, data-report-status = ok when every chart has points and no script failed).
 /// Throws dynid::Error when the Chart.js bundle cannot be read (install libjs-chart.js).
@@ -80,5 +83,15 @@ nlohmann::json prediction_plot_json(const ValidationResult& v,
 /// the result has no history.
 nlohmann::json rls_history_plot_json(const IdentificationResult& r,
                                      const PredictionPlotOptions& options = {});
+
+/// `energy` for the plot section of an integral-model identification (seed 1 Fig. 5): per interval
+/// of the first run, its end `t` [s], the `measured` work ∫τᵀq̇ dt [J] and the integral model's
+/// `predicted` (h(t_b) − h(t_a))·θ + friction work = W_b·θ̂_b [J], unweighted (integral_equations()
+/// with options.integral but IntegralWeighting::kNone, on result.processed), at most max_points
+/// intervals (every k-th); `decimated_every` k. Null when the estimate has a non-finite value (a
+/// parameter the data do not determine). Throws as integral_equations().
+nlohmann::json energy_plot_json(const Model& model, const IdentificationResult& result,
+                                const IdentifyOptions& options,
+                                const PredictionPlotOptions& plot_options = {});
 
 }  // namespace dynid

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "dynid/common/progress.hpp"
+
 namespace dynid {
 
 /// One flag of a dynid command as the command line registers it.
@@ -69,9 +71,10 @@ struct ProjectResult {
 /// directory, so any other file it writes lands there. The folder is built under
 /// "<output>.partial" and renamed to <output> (replacing an earlier run) only when every stage
 /// succeeded, with the project file and commands.txt (the command lines) copied beside the
-/// results. `progress` receives one line per stage. Throws dynid::UsageError for a malformed
-/// project, dynid::Error for a missing data file or a failing stage (the partial folder removed).
+/// results. `progress` is told before each stage (fraction of the stages done, the command line).
+/// Throws dynid::UsageError for a malformed project, dynid::Error for a missing data file or a
+/// failing stage (the partial folder removed).
 ProjectResult run_project(const ProjectOptions& options, const CommandTable& table,
-                          const std::function<void(const std::string&)>& progress);
+                          const ProgressCallback& progress = {});
 
 }  // namespace dynid
