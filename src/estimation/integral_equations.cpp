@@ -9,6 +9,7 @@
 #include "dynid/dynamics/workspace.hpp"
 #include "dynid/model/transmission.hpp"
 #include "dynid/regressor/energy_regressor.hpp"
+#include "dynid/signal/differentiation.hpp"
 #include "regressor/friction_work.hpp"
 
 namespace dynid {
@@ -86,32 +87,6 @@ void weight_rows(const Model& model, const JointRecord& r, const Eigen::VectorXd
   }
 }
 
-// Velocity at sample k as the slope at t_k of the least-squares quadratic through the processed
-// positions within ±half_width (clipped at the record's ends): a local polynomial (Savitzky–Golay)
-// derivative, used for the kinetic energy at interval ends only.
-Eigen::VectorXd local_slope(const JointRecord& r, Eigen::Index k, double half_width) {
-  const Eigen::Index m = r.t.size();
-  Eigen::Index lo = k, hi = k;
-  while (lo > 0 && r.t[k] - r.t[lo - 1] <= half_width) --lo;
-  while (hi + 1 < m && r.t[hi + 1] - r.t[k] <= half_width) ++hi;
-  if (hi - lo < 2) return r.dq.row(k).transpose();
-  const double s = std::max(r.t[hi] - r.t[k], r.t[k] - r.t[lo]);
-  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
-  for (Eigen::Index i = lo; i <= hi; ++i) {
-    const double x = (r.t[i] - r.t[k]) / s;
-    const Eigen::Vector3d v(1.0, x, x * x);
-    a += v * v.transpose();
-  }
-  // Row 1 of a⁻¹·Vᵀ: the weights that give the slope c1 from the positions.
-  const Eigen::Vector3d e1 = a.ldlt().solve(Eigen::Vector3d::UnitY());
-  Eigen::VectorXd slope = Eigen::VectorXd::Zero(r.q.cols());
-  for (Eigen::Index i = lo; i <= hi; ++i) {
-    const double x = (r.t[i] - r.t[k]) / s;
-    slope += (e1[0] + e1[1] * x + e1[2] * x * x) * r.q.row(i).transpose();
-  }
-  return slope / s;
-}
-
 }  // namespace
 
 EquationBlock integral_equations(const Model& model, const ParameterLayout& layout, bool coupling,
@@ -178,14 +153,26 @@ EquationBlock integral_equations(const Model& model, const ParameterLayout& layo
   // energy of the motor's off-diagonal inertia terms, whose torque is coupling_regressor's Iam).
   Workspace ws(model);
   Eigen::VectorXd h_prev(cols), h_next(cols);
-  const bool local = options.endpoint_window > 0.0;
+  const bool local = options.endpoint_window > 0.0 && m >= 3;
   if (!(options.endpoint_window >= 0.0) || !std::isfinite(options.endpoint_window)) {
     throw UsageError("integral endpoint window " + short_number(options.endpoint_window) +
                      " s is not a length; give a positive number of seconds (0 = off)");
   }
+  // Endpoint velocities from the local quadratic through the positions within ± the window
+  // (Savitzky–Golay slope), when asked; the power and friction columns keep the processed dq.
+  Eigen::MatrixXd fitted;
+  if (local) {
+    SavitzkyGolayOptions sg;
+    const Eigen::Index half = std::max<Eigen::Index>(
+        1, std::min<Eigen::Index>(std::llround(options.endpoint_window / step), (m - 1) / 2));
+    sg.window = static_cast<int>(2 * half + 1);
+    sg.order = 2;
+    sg.derivative = 1;
+    fitted = savitzky_golay(r.t, r.q, sg);
+  }
+  const Eigen::MatrixXd& endpoint_dq = local ? fitted : r.dq;
   auto energy_row = [&](Eigen::Index k, Eigen::VectorXd& h) {
-    const Eigen::VectorXd v = local ? local_slope(r, k, options.endpoint_window)
-                                    : Eigen::VectorXd(r.dq.row(k).transpose());
+    const Eigen::VectorXd v = endpoint_dq.row(k).transpose();
     energy_regressor(model, ws, layout, r.q.row(k).transpose(), v, h.head(p));
     for (size_t c = 0; c < motors.size(); ++c) {
       const double u = n_k[c].dot(v);

@@ -298,7 +298,7 @@ TEST(IntegralEquations, BadInputIsOneClearError) {
 // Oracle for IntegralOptions::endpoint_window: on positions that are a quadratic in time (per
 // joint, non-uniform steps), the local quadratic fit's slope is the exact velocity, so the energy
 // columns equal those built from the exact velocities even when the record's dq is wrong; at the
-// record's ends the window is clipped (one-sided fit). The friction columns still use dq.
+// record's ends the window is shifted inward. The friction columns still use dq.
 TEST(IntegralEquations, EndpointWindowSlopeIsExactOnQuadraticMotion) {
   const Model model = tx40();
   const int n = model.dof();
