@@ -9,12 +9,15 @@
 // prewhitening, MA(1) GLS (the shared end points of adjacent intervals), instrumental variables.
 // Not a benchmark: its table is in docs/methods/estimation.md ("Integral model").
 // Run: ./build/bench/integral_error_bench [position-noise-scale [torque-noise-scale [after]]]
-// (after = 1: encoder noise added to the log of a run with exact feedback, no jitter).
+// (after = 1: encoder noise added to the log of a run with exact feedback, no jitter);
+// ./build/bench/integral_error_bench window [after]: endpoint-velocity window study;
+// ./build/bench/integral_error_bench tx40 [source-dir]: the same on the real TX40 run.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <Eigen/SVD>
@@ -62,9 +65,142 @@ ProcessedRecord truth_rows(const ClosedLoopResult& r, Eigen::Index first, Eigen:
   return p;
 }
 
+// Third study: the velocity of the kinetic-energy columns at the interval ends from a local
+// quadratic fit of the processed positions (IntegralOptions::endpoint_window), over cut-offs and
+// intervals; torque-prediction error on run B.
+int endpoint_window_study(const Model& model, const ClosedLoopResult& ra,
+                          const ClosedLoopResult& rb, double ts) {
+  const JointRecord a{ra.t, ra.q, {}, {}, ra.tau}, b{rb.t, rb.q, {}, {}, rb.tau};
+  IdentifyOptions def;
+  def.signal.torque_time_offset = 0.5 * ts;
+  const IdentificationResult diff = identify(model, a, def);
+  const BaseParameters& base = diff.base;
+  auto err_b = [&](const Eigen::VectorXd& x) {
+    return 100 * validate_torques(model, b, base.names, x, def).relative_error_all;
+  };
+  std::printf("differential %.2f %%, truth %.3f %%\n", err_b(diff.estimate.x),
+              err_b(base.reduce(def.layout.parameters(model))));
+  std::printf("cutoff interval | endpoint window [ms]: 0 5 10 25 50 100\n");
+  for (double cutoff : {5.0, 10.0, 20.0, 40.0}) {
+    SignalOptions so = def.signal;
+    so.cutoff_hz = cutoff;
+    so.decimate = 1;
+    std::vector<std::pair<std::string, std::string>> choices;
+    const ProcessedRecord p = preprocess(a, so, choices);
+    for (double interval_ms : {10.0, 50.0, 100.0}) {
+      std::printf("%5.0f %5.0f |", cutoff, interval_ms);
+      for (double window_ms : {0.0, 5.0, 10.0, 25.0, 50.0, 100.0}) {
+        IntegralOptions io;
+        io.interval = 1e-3 * interval_ms;
+        io.endpoint_window = 1e-3 * window_ms;
+        const EquationBlock f = integral_equations(model, def.layout, false, p, io);
+        std::printf(" %7.2f", err_b(ordinary_least_squares(base.select(f.W), f.y).x));
+      }
+      std::printf("\n");
+    }
+  }
+  return 0;
+}
+
+// The same grid on the real TX40 run: joint friction values within 10 % of the published ones
+// (of 12), the largest friction error, the torque validation on the run and the energy
+// equations' relative error; for the defaults, every friction value with its 99.9 % interval.
+int tx40_study(const std::string& source_dir) {
+  const integral_testing::Tx40Run run = integral_testing::load_tx40(source_dir);
+  if (!run.found) {
+    std::printf("TX40 data set not found\n");
+    return 1;
+  }
+  const Model& model = run.model;
+  IdentifyOptions def;
+  const BaseParameters base = integral_testing::base_of(model, def.layout, true);
+  const IdentificationResult diff = identify(model, run.record);
+  std::printf(
+      "differential: torque %.2f %%\n",
+      100 *
+          validate_torques(model, run.record, diff.names, diff.estimate.x, def).relative_error_all);
+  auto index = [&](const std::string& name) {
+    return std::find(base.names.begin(), base.names.end(), name) - base.names.begin();
+  };
+  {
+    // Control: the integral model on torques that a rigid model explains exactly — the
+    // differential estimate's prediction on the integral processing's own states (filtered
+    // Coulomb columns included). What it recovers is the differential estimate, less the part
+    // of the error that comes from the energy equations themselves.
+    std::vector<std::pair<std::string, std::string>> choices;
+    Eigen::VectorXd x_diff(base.names.size());
+    for (size_t i = 0; i < base.names.size(); ++i) {
+      const auto it = std::find(diff.names.begin(), diff.names.end(), base.names[i]);
+      x_diff[i] = it == diff.names.end() ? 0.0 : diff.estimate.x[it - diff.names.begin()];
+    }
+    const ProcessedRecord p = integral_testing::with_model_torques(
+        model, def.layout, true, base, x_diff,
+        preprocess(run.record, integral_signal_options(), choices));
+    const Estimate e = integral_testing::estimate_with_intervals(
+        integral_equations(model, def.layout, true, p, IntegralOptions{}), base);
+    std::printf("integral model on the differential model's torques (energy error %.3f %%):\n",
+                100 * e.relative_error);
+    for (int j = 0; j < 6; ++j) {
+      for (const char* kind : {"Fv", "Fc"}) {
+        const std::string name = kind + std::to_string(j + 1);
+        const Eigen::Index i = index(name);
+        std::printf("    %s %.3f (differential %.3f)\n", name.c_str(), e.x[i], x_diff[i]);
+      }
+    }
+  }
+  std::printf("cutoff interval window | within10 maxerr%% torque%% energy%%\n");
+  for (double cutoff : {10.0, 20.0, 40.0}) {
+    SignalOptions so = integral_signal_options();
+    so.cutoff_hz = cutoff;
+    std::vector<std::pair<std::string, std::string>> choices;
+    const ProcessedRecord p = preprocess(run.record, so, choices);
+    for (double interval_ms : {10.0, 50.0}) {
+      for (double window_ms : {0.0, 10.0, 25.0, 50.0, 100.0}) {
+        IntegralOptions io;
+        io.interval = 1e-3 * interval_ms;
+        io.endpoint_window = 1e-3 * window_ms;
+        const Estimate e = integral_testing::estimate_with_intervals(
+            integral_equations(model, def.layout, true, p, io), base);
+        int within = 0;
+        double worst = 0.0;
+        const bool detail = cutoff == 10.0 && interval_ms == 10.0;
+        for (int j = 0; j < 6; ++j) {
+          for (const char* kind : {"v", "c"}) {
+            const std::string name = std::string("F") + kind + std::to_string(j + 1);
+            const double truth = run.published[kind[0] == 'v' ? "fv" : "fs"][j].as<double>();
+            const Eigen::Index i = index(name);
+            const double err = std::abs(e.x[i] - truth) / truth;
+            within += err <= 0.1;
+            worst = std::max(worst, err);
+            if (detail) {
+              std::printf("    %s %.3f [%.3f, %.3f] published %.3f%s\n", name.c_str(), e.x[i],
+                          e.ci_lower[i], e.ci_upper[i], truth,
+                          truth >= e.ci_lower[i] && truth <= e.ci_upper[i] ? "" : "  OUTSIDE");
+            }
+          }
+        }
+        const double torque =
+            validate_torques(model, run.record, base.names, e.x, def).relative_error_all;
+        std::printf("%5.0f %5.0f %5.0f | %2d %7.1f %7.2f %7.2f\n", cutoff, interval_ms, window_ms,
+                    within, 100 * worst, 100 * torque, 100 * e.relative_error);
+      }
+    }
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc > 1 && std::string(argv[1]) == "tx40") return tx40_study(argc > 2 ? argv[2] : ".");
+  if (argc > 1 && std::string(argv[1]) == "window") {
+    g_after = argc > 2 && std::atoi(argv[2]) != 0;
+    Model model = load_robot("puma560");
+    for (int j = 0; j < model.dof(); ++j) {
+      model.joints[j].friction = {0.05 * (j + 1), 0.5 + 0.1 * j, 0.3 + 0.1 * j, 0.1 * (j + 1)};
+    }
+    return endpoint_window_study(model, run(model, 1, 1e-3), run(model, 2, 1e-3), 1e-3);
+  }
   if (argc > 1) g_noise = std::atof(argv[1]);
   if (argc > 2) g_torque_noise = std::atof(argv[2]);
   if (argc > 3) g_after = std::atoi(argv[3]) != 0;

@@ -9,6 +9,7 @@
 #include "dynid/dynamics/workspace.hpp"
 #include "dynid/model/transmission.hpp"
 #include "dynid/regressor/energy_regressor.hpp"
+#include "dynid/signal/differentiation.hpp"
 #include "regressor/friction_work.hpp"
 
 namespace dynid {
@@ -152,11 +153,30 @@ EquationBlock integral_equations(const Model& model, const ParameterLayout& layo
   // energy of the motor's off-diagonal inertia terms, whose torque is coupling_regressor's Iam).
   Workspace ws(model);
   Eigen::VectorXd h_prev(cols), h_next(cols);
+  const bool local = options.endpoint_window > 0.0 && m >= 3;
+  if (!(options.endpoint_window >= 0.0) || !std::isfinite(options.endpoint_window)) {
+    throw UsageError("integral endpoint window " + short_number(options.endpoint_window) +
+                     " s is not a length; give a positive number of seconds (0 = off)");
+  }
+  // Endpoint velocities from the local quadratic through the positions within ± the window
+  // (Savitzky–Golay slope), when asked; the power and friction columns keep the processed dq.
+  Eigen::MatrixXd fitted;
+  if (local) {
+    SavitzkyGolayOptions sg;
+    const Eigen::Index half = std::max<Eigen::Index>(
+        1, std::min<Eigen::Index>(std::llround(options.endpoint_window / step), (m - 1) / 2));
+    sg.window = static_cast<int>(2 * half + 1);
+    sg.order = 2;
+    sg.derivative = 1;
+    fitted = savitzky_golay(r.t, r.q, sg);
+  }
+  const Eigen::MatrixXd& endpoint_dq = local ? fitted : r.dq;
   auto energy_row = [&](Eigen::Index k, Eigen::VectorXd& h) {
-    energy_regressor(model, ws, layout, r.q.row(k).transpose(), r.dq.row(k).transpose(), h.head(p));
+    const Eigen::VectorXd v = endpoint_dq.row(k).transpose();
+    energy_regressor(model, ws, layout, r.q.row(k).transpose(), v, h.head(p));
     for (size_t c = 0; c < motors.size(); ++c) {
-      const double u = n_k[c].dot(r.dq.row(k));
-      const double diag = (n_k[c].array().square() * r.dq.row(k).array().square()).sum();
+      const double u = n_k[c].dot(v);
+      const double diag = (n_k[c].array().square().transpose() * v.array().square()).sum();
       h[p + 3 * static_cast<Eigen::Index>(c)] = 0.5 * (u * u - diag);
       h[p + 3 * static_cast<Eigen::Index>(c) + 1] = 0.0;
       h[p + 3 * static_cast<Eigen::Index>(c) + 2] = 0.0;

@@ -278,6 +278,9 @@ TEST(IntegralEquations, BadInputIsOneClearError) {
   expect(o, "longer than the run", true);
   o.interval = -1.0;
   expect(o, "not a length", true);
+  o = IntegralOptions{};
+  o.endpoint_window = -0.01;
+  expect(o, "endpoint window", true);
   ProcessedRecord still = p;
   still.record.q.rowwise() = p.record.q.row(0);
   still.record.dq.setZero();
@@ -290,6 +293,48 @@ TEST(IntegralEquations, BadInputIsOneClearError) {
   ProcessedRecord no_tau = p;
   no_tau.record.tau.resize(0, 0);
   EXPECT_THROW(integral_equations(r.model, r.layout, false, no_tau, {}), Error);
+}
+
+// Oracle for IntegralOptions::endpoint_window: on positions that are a quadratic in time (per
+// joint, non-uniform steps), the local quadratic fit's slope is the exact velocity, so the energy
+// columns equal those built from the exact velocities even when the record's dq is wrong; at the
+// record's ends the window is shifted inward. The friction columns still use dq.
+TEST(IntegralEquations, EndpointWindowSlopeIsExactOnQuadraticMotion) {
+  const Model model = tx40();
+  const int n = model.dof();
+  const Eigen::Index m = 201;
+  ProcessedRecord exact;
+  exact.record.t.resize(m);
+  for (Eigen::Index k = 0; k < m; ++k) exact.record.t[k] = 1e-3 * k + 2e-4 * std::sin(0.7 * k);
+  exact.record.q.resize(m, n);
+  exact.record.dq.resize(m, n);
+  exact.record.tau.setZero(m, n);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    const double t = exact.record.t[k];
+    for (int j = 0; j < n; ++j) {
+      const double a = 0.3 - 0.1 * j, b = 1.0 + 0.2 * j, c = -2.0 + 0.5 * j;
+      exact.record.q(k, j) = a + b * t + c * t * t;
+      exact.record.dq(k, j) = b + 2 * c * t;
+    }
+  }
+  ProcessedRecord wrong = exact;
+  wrong.record.dq *= 1.1;
+  IntegralOptions o;
+  o.interval = 0.02;
+  o.weighting = IntegralWeighting::kNone;
+  const EquationBlock reference =
+      integral_equations(model, ParameterLayout::full(), true, exact, o);
+  o.endpoint_window = 0.015;
+  const EquationBlock fitted = integral_equations(model, ParameterLayout::full(), true, wrong, o);
+  const Eigen::Index link = kLinkParams * n;
+  const double scale = reference.W.leftCols(link).cwiseAbs().maxCoeff();
+  EXPECT_LT((fitted.W.leftCols(link) - reference.W.leftCols(link)).cwiseAbs().maxCoeff(),
+            1e-9 * scale);
+  // Negative control: without the window the wrong velocities change the energy columns.
+  o.endpoint_window = 0.0;
+  const EquationBlock unfitted = integral_equations(model, ParameterLayout::full(), true, wrong, o);
+  EXPECT_GT((unfitted.W.leftCols(link) - reference.W.leftCols(link)).cwiseAbs().maxCoeff(),
+            1e-3 * scale);
 }
 
 // The default row weights follow the endpoint-momentum noise model: row i of the weighted block is

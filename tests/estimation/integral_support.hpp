@@ -3,9 +3,13 @@
 // Simulated runs for the integral-model tests: closed-loop runs of dynid's native plant (RK4 on
 // the mass matrix and RNEA, not on the energy equations) or MuJoCo, tracking a multi-sine.
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <random>
+#include <string>
 
+#include <yaml-cpp/yaml.h>
 #include <Eigen/Core>
 
 #include "dynid/estimation/equation_block.hpp"
@@ -13,7 +17,10 @@
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/statistics.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
+#include "dynid/io/csv_reader.hpp"
 #include "dynid/model/model.hpp"
+#include "dynid/model/robots.hpp"
+#include "dynid/model/transmission.hpp"
 #include "dynid/sim/closed_loop.hpp"
 #include "dynid/sim/pid_controller.hpp"
 #include "dynid/sim/plant.hpp"
@@ -100,6 +107,61 @@ inline Estimate estimate_with_intervals(const EquationBlock& b, const BaseParame
   const Eigen::VectorXd res = b.y - Wb * e.x;
   apply_hac_covariance(e, Wb, res, b.sample, eo);
   return e;
+}
+
+/// `processed` with its torques replaced by those a rigid model explains exactly: base parameters
+/// `x` (of `base`) through processed_regressor on the record's own q, dq, ddq and filtered Coulomb
+/// indicators. Built in chunks of samples to bound the regressor's memory.
+inline ProcessedRecord with_model_torques(const Model& model, const ParameterLayout& layout,
+                                          bool coupling, const BaseParameters& base,
+                                          const Eigen::VectorXd& x, ProcessedRecord processed) {
+  const Eigen::Index m = processed.record.t.size();
+  const int n = model.dof();
+  const bool coulomb = processed.moving_positive.rows() == m;
+  for (Eigen::Index first = 0; first < m; first += 4096) {
+    const Eigen::Index len = std::min<Eigen::Index>(4096, m - first);
+    ProcessedRecord chunk;
+    chunk.record.t = processed.record.t.segment(first, len);
+    chunk.record.q = processed.record.q.middleRows(first, len);
+    chunk.record.dq = processed.record.dq.middleRows(first, len);
+    chunk.record.ddq = processed.record.ddq.middleRows(first, len);
+    if (coulomb) {
+      chunk.moving_positive = processed.moving_positive.middleRows(first, len);
+      chunk.moving_negative = processed.moving_negative.middleRows(first, len);
+    }
+    const Eigen::VectorXd tau =
+        base.select(processed_regressor(model, layout, coupling, chunk)) * x;
+    for (Eigen::Index k = 0; k < len; ++k)
+      processed.record.tau.row(first + k) = tau.segment(k * n, n).transpose();
+  }
+  return processed;
+}
+
+/// The real Stäubli TX40 run of examples/staubli-tx40/dataset (SOURCE.md): joint-side record
+/// (motor positions and torques through the coupled transmission), the model, and the published
+/// friction (config robot_params). `found` is false when the data set is absent.
+struct Tx40Run {
+  bool found = false;
+  Model model;
+  JointRecord record;
+  YAML::Node published;
+};
+
+inline Tx40Run load_tx40(const std::string& source_dir) {
+  Tx40Run r;
+  const std::string data = source_dir + "/examples/staubli-tx40/dataset";
+  if (!std::filesystem::exists(data + "/data/pos_read_data.csv")) return r;
+  r.found = true;
+  r.model = load_robot(source_dir + "/examples/staubli-tx40/tx40.yaml");
+  const CsvTable pos = read_csv(data + "/data/pos_read_data.csv");
+  const CsvTable cur = read_csv(data + "/data/curr_data.csv");
+  const YAML::Node config = YAML::LoadFile(data + "/config/T40X_config.yaml")["identification"];
+  r.published = config["robot_params"][0];
+  const double ts = config["processing_params"][0]["ts"].as<double>();
+  r.record.t = Eigen::VectorXd::LinSpaced(pos.rows(), 0.0, (pos.rows() - 1) * ts);
+  r.record.q = joint_positions_from_motor(r.model, pos.data);
+  r.record.tau = joint_torques_from_motor(r.model, cur.data);
+  return r;
 }
 
 }  // namespace dynid::integral_testing

@@ -25,23 +25,23 @@ struct Tx40Integral {
   JointRecord record;
   BaseParameters base;
   Estimate estimate;
+  /// The integral estimate on torques the differential estimate explains exactly (control), and
+  /// the differential estimate on the integral model's base parameters.
+  Estimate rigid_estimate;
+  Eigen::VectorXd differential_x;
+  int differential_missing = 0;  ///< integral base parameters the differential result lacks
   ValidationResult integral_validation, differential_validation;
   double differential_relative_error = 0.0;
   YAML::Node published;
 };
 
 const Tx40Integral* load() {
-  if (!std::filesystem::exists(kData + "/data/pos_read_data.csv")) return nullptr;
+  integral_testing::Tx40Run run = integral_testing::load_tx40(DYNID_SOURCE_DIR);
+  if (!run.found) return nullptr;
   auto* r = new Tx40Integral;
-  r->model = load_robot(std::string(DYNID_SOURCE_DIR) + "/examples/staubli-tx40/tx40.yaml");
-  const CsvTable pos = read_csv(kData + "/data/pos_read_data.csv");
-  const CsvTable cur = read_csv(kData + "/data/curr_data.csv");
-  const YAML::Node config = YAML::LoadFile(kData + "/config/T40X_config.yaml")["identification"];
-  r->published = config["robot_params"][0];
-  const double ts = config["processing_params"][0]["ts"].as<double>();
-  r->record.t = Eigen::VectorXd::LinSpaced(pos.rows(), 0.0, (pos.rows() - 1) * ts);
-  r->record.q = joint_positions_from_motor(r->model, pos.data);
-  r->record.tau = joint_torques_from_motor(r->model, cur.data);
+  r->model = std::move(run.model);
+  r->record = std::move(run.record);
+  r->published = run.published;
   IdentifyOptions io;
   io.signal = integral_signal_options();
   std::vector<std::pair<std::string, std::string>> choices;
@@ -56,6 +56,18 @@ const Tx40Integral* load() {
   r->integral_validation =
       validate_torques(r->model, r->record, r->base.names, r->estimate.x, IdentifyOptions{});
   const IdentificationResult diff = identify(r->model, r->record);
+  r->differential_x.resize(r->base.names.size());
+  for (size_t i = 0; i < r->base.names.size(); ++i) {
+    const auto it = std::find(diff.names.begin(), diff.names.end(), r->base.names[i]);
+    r->differential_missing += it == diff.names.end();
+    r->differential_x[i] = it == diff.names.end() ? 0.0 : diff.estimate.x[it - diff.names.begin()];
+  }
+  r->rigid_estimate = integral_testing::estimate_with_intervals(
+      integral_equations(r->model, io.layout, true,
+                         integral_testing::with_model_torques(r->model, io.layout, true, r->base,
+                                                              r->differential_x, p),
+                         IntegralOptions{}),
+      r->base);
   r->differential_relative_error = diff.relative_error;
   r->differential_validation =
       validate_torques(r->model, r->record, diff.names, diff.estimate.x, IdentifyOptions{});
@@ -76,11 +88,10 @@ double value(const Tx40Integral& r, const std::string& name) {
 // What the integral model gets on this run with its defaults (issue 11 item 7; numbers in
 // docs/methods/estimation.md, "Integral model"): of the 12 joint friction values, Fv1, Fv2 and Fv5
 // are within 10 % of the published ones (and Fvm6); the Coulomb values are not (Fc4 with the
-// wrong sign), and the torque prediction is ~7× worse than the differential model's. One scalar
-// equation per interval sums the power of all six joints, so the small joints' friction is
-// weakly determined. Parallel filtering of the Coulomb work raised the count from 1 to 3 and cut
-// the torque error from 41 % to 35 %. The test pins these numbers so that a change to the builder
-// or the defaults that moves them is seen.
+// wrong sign), and the torque prediction is ~7× worse than the differential model's. Why: the run
+// does not determine them to 10 % — the intervals are wider than that, and contain 11 of the 12
+// published values — and the control test below shows that the builder is not the cause. The test
+// pins these numbers so that a change to the builder or the defaults that moves them is seen.
 TEST(IntegralTx40, FrictionAgainstPublishedValues) {
   const Tx40Integral* r = data();
   if (r == nullptr) GTEST_SKIP() << "data set not found at " << kData;
@@ -103,8 +114,54 @@ TEST(IntegralTx40, FrictionAgainstPublishedValues) {
   }
   EXPECT_NEAR(value(*r, "Fvm6"), fvm, 0.1 * fvm);
   EXPECT_EQ(within, 3) << "of the 12 joint friction values within 10 %";
+  // Why 10 % is out of reach: the run does not determine the Coulomb values that closely. Every
+  // Coulomb value's 99.9 % interval (HAC) is wider than ± its published value, and the published
+  // values lie inside the intervals except Fc4's (just outside: −4.2 to 2.2 against 2.48).
+  int inside = 0;
+  for (int j = 0; j < 6; ++j) {
+    const std::string k = std::to_string(j + 1);
+    const double fs = r->published["fs"][j].as<double>();
+    const Eigen::Index c =
+        std::find(r->base.names.begin(), r->base.names.end(), "Fc" + k) - r->base.names.begin();
+    EXPECT_GT(0.5 * (r->estimate.ci_upper[c] - r->estimate.ci_lower[c]), fs) << "Fc" << k;
+    for (const char* kind : {"Fv", "Fc"}) {
+      const double truth = r->published[kind[1] == 'v' ? "fv" : "fs"][j].as<double>();
+      const Eigen::Index i =
+          std::find(r->base.names.begin(), r->base.names.end(), kind + k) - r->base.names.begin();
+      inside += truth >= r->estimate.ci_lower[i] && truth <= r->estimate.ci_upper[i];
+    }
+  }
+  EXPECT_EQ(inside, 11) << "published friction values inside the 99.9 % intervals";
   std::cout << "energy equations: relative error " << r->estimate.relative_error << "\n";
   EXPECT_LT(r->estimate.relative_error, 0.05);
+}
+
+// Control for the test above: with the measured torques replaced by those the differential
+// estimate explains exactly (its prediction on the integral processing's own states), the energy
+// equations return the differential estimate's friction. The builder is faithful on this robot,
+// coupled wrist included; what moves the integral estimate on the measured torques is the part of
+// them the rigid model does not explain (the differential model's 4.9 % torque residual), which
+// the weakly determined directions of one scalar equation per interval absorb.
+TEST(IntegralTx40, RecoversTheFrictionOfTorquesARigidModelExplains) {
+  const Tx40Integral* r = data();
+  if (r == nullptr) GTEST_SKIP() << "data set not found at " << kData;
+  ASSERT_EQ(r->differential_missing, 0);
+  std::cout << "energy equations on rigid-model torques: relative error "
+            << r->rigid_estimate.relative_error << "\n";
+  EXPECT_LT(r->rigid_estimate.relative_error, 2e-5);
+  double worst = 0.0;
+  for (int j = 0; j < 6; ++j) {
+    for (const char* kind : {"Fv", "Fc"}) {
+      const std::string name = kind + std::to_string(j + 1);
+      const Eigen::Index i =
+          std::find(r->base.names.begin(), r->base.names.end(), name) - r->base.names.begin();
+      const double d = r->differential_x[i];
+      worst = std::max(worst, std::abs(r->rigid_estimate.x[i] - d) / std::abs(d));
+      EXPECT_NEAR(r->rigid_estimate.x[i], d, 2e-3 * std::abs(d)) << name;
+    }
+  }
+  std::cout << "largest relative friction difference to the differential estimate " << worst
+            << "\n";
 }
 
 TEST(IntegralTx40, TorqueValidationBesideTheDifferentialModel) {

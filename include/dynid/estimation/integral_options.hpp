@@ -37,6 +37,9 @@ struct IntegralOptions {
   /// How the short-integral rows are weighted (IntegralWeighting). Long rows share their start
   /// and are left unweighted.
   IntegralWeighting weighting = IntegralWeighting::kEndpointMomentum;
+  /// Half-width [s] of the local quadratic fit of the processed positions that gives the
+  /// velocities of the kinetic-energy columns at the interval ends; 0 = the processed velocity.
+  double endpoint_window = 0.0;
 };
 
 }  // namespace dynid
