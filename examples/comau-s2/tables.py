@@ -114,9 +114,17 @@ for j in range(1, 7):
     v = load(f"validation_{j}.json")["joints"][j - 1]
     print(f"{j:<7} {math.degrees(v['position']['max']):>20.4g} {v['torque']['rms']:>24.4g}")
 
-control = load("control.json")
-print("\nTracking error on joint 1's Fourier reference (paper's Fig. 9), max over the joints [deg]:")
 summary_control = {}
+if not os.path.exists(os.path.join(out, "control.json")):
+    with open(os.path.join(out, "control.log")) as f:
+        print("\nComputed torque from the identified model: not run: " +
+              f.read().strip().splitlines()[-1])
+    control = {"controllers": []}
+else:
+    control = load("control.json")
+if control["controllers"]:
+    print("\nTracking error on joint 1's Fourier reference (paper's Fig. 9), max over the joints "
+          "[deg]:")
 for c in control["controllers"]:
     peak = max(jt["max"] for jt in c["joints"])
     summary_control[c["name"]] = peak
