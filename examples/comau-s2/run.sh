@@ -17,7 +17,7 @@
 # Usage: examples/comau-s2/run.sh [OUT_DIR]   (default comau-s2-out; DYNID=path/to/dynid)
 # Environment: PERIODS (25, as in the paper), RATE (control and logging rate, 1000 Hz as in the
 #   paper), SEED (1). Runtime on 2 busy shared cores: 5-7 min with the defaults; PERIODS=3
-#   RATE=200 (the test's setting) about 6 s of CPU, 30-60 s wall clock.
+#   RATE=200 (the test's setting) about 9 s of CPU, 27-80 s wall clock.
 # Not in this chain: the paper's 8th-order Chebyshev filter at 80 Hz and resampling to 200 Hz.
 #   `identify --closed-loop spectral` replaces filtering and decimation by the projection on the
 #   lines at or below the excitation band (0.5 Hz), which removes everything a filter at 80 Hz
