@@ -156,7 +156,10 @@ std::pair<double, double> band_energy(const Eigen::Ref<const Eigen::VectorXd>& x
   return {total, kept};
 }
 
-void check_reference(const JointRecord& run, const ReferenceRecord& reference) {
+// held_joints_allowed: the spectral lines come from the moving joints' references, so a one-joint
+// run (seed 2 section 3: the other joints held) is fine; the projection's FIR needs every one.
+void check_reference(const JointRecord& run, const ReferenceRecord& reference,
+                     bool held_joints_allowed = false) {
   const Eigen::Index m = run.t.size(), n = run.q.cols();
   if (reference.qr.size() == 0)
     throw Error("closed-loop identification needs the reference columns qr1..qr" +
@@ -174,13 +177,19 @@ void check_reference(const JointRecord& run, const ReferenceRecord& reference) {
   check(reference.qr, "qr", false);
   check(reference.dqr, "dqr", true);
   check(reference.ddqr, "ddqr", true);
+  Eigen::Index moving = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
     const double mean = reference.qr.col(i).mean();
-    if ((reference.qr.col(i).array() - mean).abs().maxCoeff() <=
-        1e-12 * std::max(1.0, std::abs(mean)))
+    const bool constant = (reference.qr.col(i).array() - mean).abs().maxCoeff() <=
+                          1e-12 * std::max(1.0, std::abs(mean));
+    if (constant && !held_joints_allowed)
       throw Error("reference qr" + std::to_string(i + 1) + " is constant (" + num(mean) +
                   "): it drives nothing the projection can use; excite every joint");
+    moving += constant ? 0 : 1;
   }
+  if (moving == 0)
+    throw Error("every reference qr1..qr" + std::to_string(n) +
+                " is constant: the run excites nothing; move at least one joint");
 }
 
 ClosedLoopRun prepare_projection(const JointRecord& run, const ReferenceRecord& reference,
@@ -289,6 +298,20 @@ ClosedLoopRun prepare_spectral(const JointRecord& run, const ReferenceRecord& re
   r.dq = projector->derivative(q, 1);
   r.ddq = projector->derivative(q, 2);
   r.tau = projector->project(run.tau.middleRows(first, len));
+  // A joint whose reference is constant was held by the controller (one-joint runs, seed 2
+  // section 3): its projected motion is tracking error, not excitation, and would make its
+  // velocity columns (Ia, friction) look excited; taken as still, as identify's still joints.
+  std::string held;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    if (amplitude.col(j).maxCoeff() > 0.0) continue;
+    r.dq.col(j).setZero();
+    r.ddq.col(j).setZero();
+    held += (held.empty() ? "" : ", ") + std::to_string(j + 1);
+  }
+  if (!held.empty())
+    choices.emplace_back("still_joints", "joints " + held +
+                                             " (constant reference): held, velocity and "
+                                             "acceleration taken as zero");
   out.processed.rate_hz = 1.0 / ts;
   out.processed.position_noise_std =
       ((q - r.q).colwise().squaredNorm() / static_cast<double>(len)).cwiseSqrt().transpose();
@@ -312,7 +335,7 @@ ClosedLoopRun prepare_closed_loop(const JointRecord& input, const ReferenceRecor
                                   std::vector<std::pair<std::string, std::string>>& choices) {
   if (options.method == ClosedLoopMethod::kNone)
     throw Error("prepare_closed_loop: no closed-loop method chosen");
-  check_reference(input, reference);
+  check_reference(input, reference, options.method == ClosedLoopMethod::kSpectral);
   const SamplingInfo info =
       require_uniform_sampling(input.t, 1e-6, "closed-loop identification (the reference's lags)");
   const double ts = info.mean_period;

@@ -453,11 +453,6 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
   check_closed_loop_request(options, runs.size(), references.size());
   Eigen::Index projected_dimensions = 0;  // Σ over runs and joints of the projector's rank
   std::vector<ProcessedRecord> prepared;  // every run's (maximum likelihood needs them all)
-  if (closed && !options.known_friction.empty()) {
-    throw UsageError(
-        "known friction is subtracted before the differential model's own preparation; it is not "
-        "available with --closed-loop (leave out --friction-known or the closed-loop preparation)");
-  }
   if (integral) {
     std::ostringstream m;
     m << "integral (energy) model, "
@@ -482,9 +477,12 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
       co.torque_time_offset = options.signal.torque_time_offset;
       ClosedLoopRun cl = prepare_closed_loop(screened.back().record, references[i], co, choices);
       processed = std::move(cl.processed);
-      blocks.push_back(project_equations(
-          differential_equations(model, options.layout, coupling, processed, Eigen::VectorXd()),
-          *cl.projector));
+      // Known friction (seed 2 section 3.4) leaves the torque before the projection, so that
+      // both sides of the regression are projected alike.
+      EquationBlock raw =
+          differential_equations(model, options.layout, coupling, processed, Eigen::VectorXd());
+      subtract_known_friction(model, options.known_friction, processed, raw);
+      blocks.push_back(project_equations(raw, *cl.projector));
       projected_dimensions += static_cast<Eigen::Index>(n) * cl.report.rank;
       result.closed_loop.push_back(std::move(cl.report));
     } else if (integral) {

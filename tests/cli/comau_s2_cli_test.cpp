@@ -1,0 +1,60 @@
+// Seed 2's experiments in simulation (B. Bona, A. Curatella, "Closed-loop rigid model
+// identification of an industrial robot", 2005, section 3): examples/comau-s2/run.sh end to end on
+// the built-in comau-s2 under a plain PID, shortened (2 periods per Fourier run after the
+// transient, 200 Hz) but with every step of the chain. The truth in summary.json comes from the
+// model file and dynid inverse-dynamics, never from an estimate.
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+nlohmann::json load(const std::filesystem::path& path) {
+  std::ifstream f(path);
+  return nlohmann::json::parse(f);
+}
+
+TEST(ComauS2Example, TruthInsideTheIntervalsButOneKnownBiasAndComputedTorqueTracksBetter) {
+  const auto out = std::filesystem::path(::testing::TempDir()) / "comau_s2";
+  std::filesystem::remove_all(out);
+  const std::string command =
+      std::string("DYNID='") + DYNID_BINARY + "' PERIODS=3 RATE=200 SEED=1 '" + DYNID_SOURCE_DIR +
+      "/examples/comau-s2/run.sh' '" + out.string() + "' > '" + (out.string() + ".log") + "' 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << "see " << out.string() << ".log";
+  const nlohmann::json s = load(out / "summary.json");
+  int table[4] = {0, 0, 0, 0};
+  std::vector<std::string> outside;
+  for (const auto& p : s["parameters"]) {
+    const double truth = p["truth"], lo = p["ci_low"], hi = p["ci_high"];
+    const std::string name = p["name"], t = p["table"];
+    if (!(lo <= truth && truth <= hi)) outside.push_back("Table " + t + " " + name);
+    ++table[std::stoi(t)];
+  }
+  // KNOWN BIAS (docs/methods/experiments.md, "Seed 2's case in simulation"): a held joint slides
+  // by its tracking error inside the plant's Coulomb smoothing band, and that friction in its
+  // torque rows pulls MY3R 3.5 sigma off (3.9 sigma with 25 periods at 1 kHz). Every other
+  // interval holds the truth; this fails as soon as anything else leaves its interval, or once
+  // the bias is fixed (then drop this exception).
+  EXPECT_EQ(outside, std::vector<std::string>{"Table 3 MY3R"});
+  EXPECT_EQ(table[1], 4);                          // k, q_off of joints 2 and 3
+  EXPECT_EQ(table[2], 6 * 4);                      // Fvp Fvn Fcp Fcn of every joint
+  EXPECT_EQ(table[3], s["data_rank"].get<int>());  // every excited base parameter checked
+  // Seed 2 Fig. 9: the model-based controller's peak tracking error is below the PID's.
+  const nlohmann::json c = load(out / "control.json");
+  double peak[2] = {0.0, 0.0};
+  for (const auto& controller : c["controllers"]) {
+    double m = 0.0;
+    for (const auto& j : controller["joints"]) m = std::max(m, j["max"].get<double>());
+    peak[controller["name"] == "pid" ? 0 : 1] = m;
+  }
+  EXPECT_GT(peak[0], 0.0);
+  EXPECT_LT(peak[1], peak[0]);
+}
+
+}  // namespace
