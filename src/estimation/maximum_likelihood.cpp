@@ -335,6 +335,21 @@ Estimate maximum_likelihood(const EquationBlock& block, const Eigen::MatrixXd& s
   return est;
 }
 
+namespace {
+
+// Processed-signal noise from raw σ_q, σ_τ and the white-noise gains g_k of k derivatives.
+MeasurementNoise scaled_noise(const Eigen::VectorXd& sq, const Eigen::VectorXd& st, double g0,
+                              double g1, double g2) {
+  MeasurementNoise out;
+  out.q = g0 * sq;
+  out.dq = g1 * sq;
+  out.ddq = g2 * sq;
+  out.tau = g0 * st;
+  return out;
+}
+
+}  // namespace
+
 MeasurementNoise processed_noise(const SensorNoise& given, const SignalOptions& signal,
                                  const ProcessedRecord& processed, const JointRecord& raw,
                                  std::string& how) {
@@ -378,11 +393,7 @@ MeasurementNoise processed_noise(const SensorNoise& given, const SignalOptions& 
   const SosFilter* f = filtered ? &filter : nullptr;
   const double g0 = white_noise_gain(f, 0, rate), g1 = white_noise_gain(f, 1, rate),
                g2 = white_noise_gain(f, 2, rate);
-  MeasurementNoise out;
-  out.q = g0 * sq;
-  out.dq = g1 * sq;
-  out.ddq = g2 * sq;
-  out.tau = g0 * st;
+  const MeasurementNoise out = scaled_noise(sq, st, g0, g1, g2);
   std::ostringstream s;
   s << std::setprecision(3) << "raw std q [" << sq.transpose() << "] " << source_q << ", tau ["
     << st.transpose() << "] " << source_tau << "; through the "
@@ -427,11 +438,7 @@ MeasurementNoise projected_noise(const SensorNoise& given, const SignalProjector
   const double g0 = std::sqrt(U.squaredNorm() / static_cast<double>(len));
   const double g1 = std::sqrt(d1.squaredNorm() / static_cast<double>(inner));
   const double g2 = std::sqrt(d2.squaredNorm() / static_cast<double>(inner));
-  MeasurementNoise out;
-  out.q = g0 * sq;
-  out.dq = g1 * sq;
-  out.ddq = g2 * sq;
-  out.tau = g0 * st;
+  const MeasurementNoise out = scaled_noise(sq, st, g0, g1, g2);
   std::ostringstream s;
   s << std::setprecision(3) << "std q [" << sq.transpose() << "] "
     << (given.q.size() ? "given" : "of the remainder q - q^ (taken as white)") << ", tau ["
