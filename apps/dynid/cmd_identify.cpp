@@ -64,6 +64,7 @@ struct IdentifyCliOptions {
   std::vector<std::string> friction_known;  // --friction-known, repeatable
   std::string closed_loop = "none";         // --closed-loop
   std::string fir;                          // --fir M1,M2
+  double period = 0.0, f0 = 0.0;            // --period S, --f0 HZ (spectral)
   std::string noise, noise_std;             // --noise FILE, --noise-std q=S,tau=S (ml)
   std::string repeat;                       // --repeat periods|runs
   std::string report;                       // --report
@@ -248,6 +249,14 @@ IdentifyOptions library_options(const IdentifyCliOptions& o) {
                        "' is not M1,M2 (two integers >= 0: future and past reference lags)");
     }
   }
+  if (o.period != 0.0 || o.f0 != 0.0) {
+    if (o.closed_loop != "spectral")
+      throw UsageError(
+          "--period/--f0 give the reference's period: they need --closed-loop spectral");
+    if ((o.period != 0.0) == (o.f0 != 0.0) || !(o.period >= 0.0) || !(o.f0 >= 0.0))
+      throw UsageError("give one of --period S or --f0 HZ, > 0");
+    out.closed_loop.period = o.period > 0.0 ? o.period : 1.0 / o.f0;
+  }
   if (o.model == "integral") {
     out.model = IdentificationModel::kIntegral;
     if (!(o.interval >= 0.0)) {
@@ -285,6 +294,8 @@ nlohmann::json echo(const IdentifyCliOptions& o) {
           {"friction_known", o.friction_known},
           {"closed_loop", o.closed_loop},
           {"fir", o.fir},
+          {"period", o.period},
+          {"f0", o.f0},
           {"noise", o.noise},
           {"noise_std", o.noise_std},
           {"repeat", o.repeat}};
@@ -805,6 +816,17 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
     if (!v.zero_velocity.empty()) throw;
     throw file_option_error(e, v.params);
   }
+  // Closed-loop results are validated on the measured torques: the question is how well the model
+  // predicts what the robot measures (docs/methods/projection.md, "Validation").
+  const std::string closed =
+      FileOptions{identified.options, v.params}.get("closed_loop", std::string("none"));
+  if (closed != "none")
+    result.choices.emplace_back(
+        "closed_loop",
+        "identified with --closed-loop " + closed +
+            "; validated on this run's measured torques, filtered and not projected (a projection "
+            "keeps only the reference's band and would hide the noise and the loop's response "
+            "the model must predict)");
   echo_choices("validate", read, result.choices);
   if (!result.rms.allFinite() || !result.relative_error.allFinite() ||
       !std::isfinite(result.relative_error_all) || !std::isfinite(result.relative_error_all_rows)) {
@@ -941,6 +963,11 @@ void add_identify_command(CLI::App& app) {
   cmd->add_option("--fir", o->fir,
                   "With --closed-loop projection: FIR orders M1,M2 (future, past reference "
                   "lags); default: the smallest passing a remainder-reference correlation test");
+  cmd->add_option("--period", o->period,
+                  "With --closed-loop spectral: the reference's period [s] (default: detected "
+                  "from qr, which must then repeat exactly)");
+  cmd->add_option("--f0", o->f0,
+                  "With --closed-loop spectral: the fundamental [Hz] instead of --period");
   cmd->add_option("--noise", o->noise,
                   "With --estimator ml: noise JSON of dynid average --json (std of q<j>, tau<j>)");
   cmd->add_option("--noise-std", o->noise_std,

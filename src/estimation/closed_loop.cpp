@@ -218,6 +218,7 @@ ClosedLoopRun prepare_projection(const JointRecord& run, const ReferenceRecord& 
   ClosedLoopRun out;
   out.processed = std::move(p.processed);
   out.projector = p.projector;
+  out.torque_remainder_std = p.torque_remainder_std;
   ClosedLoopReport& rep = out.report;
   rep.method = ClosedLoopMethod::kProjection;
   rep.rank = p.projector->rank();
@@ -238,11 +239,47 @@ ClosedLoopRun prepare_projection(const JointRecord& run, const ReferenceRecord& 
   return out;
 }
 
+// The user's period (options.period [s]) in samples, checked against the run: a whole number of
+// samples, two periods in the run, and qr repeating with it to options.given_period_tolerance.
+int given_period(const Eigen::MatrixXd& qr, const ClosedLoopIdOptions& options, double ts,
+                 std::vector<std::pair<std::string, std::string>>& choices) {
+  const double samples = options.period / ts;
+  const double whole = std::round(samples);
+  if (!std::isfinite(samples) || std::abs(samples - whole) > 1e-6 * std::max(whole, 1.0) ||
+      whole < 2.0)
+    throw Error("--period " + num(options.period) + " s is " + num(samples) +
+                " samples at this run's sampling interval " + num(ts) +
+                " s; the spectral lines need a whole number of samples per period: check --period/"
+                "--f0 or resample the run");
+  const Eigen::Index m = qr.rows(), p = static_cast<Eigen::Index>(whole);
+  if (2 * p > m)
+    throw Error("--period " + num(options.period) + " s (" + std::to_string(p) +
+                " samples) leaves fewer than two whole periods in the run's " + std::to_string(m) +
+                " samples: check --period/--f0 or record more periods");
+  double worst = 0.0;
+  for (Eigen::Index j = 0; j < qr.cols(); ++j) {
+    const double range = qr.col(j).maxCoeff() - qr.col(j).minCoeff();
+    const double d = (qr.col(j).tail(m - p) - qr.col(j).head(m - p)).cwiseAbs().maxCoeff();
+    const double rel = d / std::max(range, 1e-300);
+    if (rel > options.given_period_tolerance)
+      throw Error("qr" + std::to_string(j + 1) + " does not repeat with --period " +
+                  num(options.period) + " s: qr(t + T) - qr(t) reaches " + num(rel) +
+                  " of its range (at most " + num(options.given_period_tolerance) +
+                  "); check --period/--f0 against the reference");
+    worst = std::max(worst, rel);
+  }
+  choices.emplace_back("period", "given: " + num(options.period) + " s = " + std::to_string(p) +
+                                     " samples; qr repeats with it to " + num(worst) +
+                                     " of its range");
+  return static_cast<int>(p);
+}
+
 ClosedLoopRun prepare_spectral(const JointRecord& run, const ReferenceRecord& reference,
                                const ClosedLoopIdOptions& options, double ts,
                                std::vector<std::pair<std::string, std::string>>& choices) {
   const Eigen::Index m = run.t.size(), n = run.q.cols();
-  int p = exact_period(reference.qr);
+  int p = options.period > 0.0 ? given_period(reference.qr, options, ts, choices)
+                               : exact_period(reference.qr);
   if (p == 0 && reference.dqr.size() != 0 && m > 2) {
     // One period alone cannot show that it repeats; a given derivative can: it equals the Fourier
     // derivative of qr taken as one period exactly when qr is one period of a periodic signal.
@@ -316,6 +353,10 @@ ClosedLoopRun prepare_spectral(const JointRecord& run, const ReferenceRecord& re
   out.processed.position_noise_std =
       ((q - r.q).colwise().squaredNorm() / static_cast<double>(len)).cwiseSqrt().transpose();
   out.processed.velocity_noise_std = Eigen::VectorXd::Zero(n);
+  out.torque_remainder_std =
+      ((run.tau.middleRows(first, len) - r.tau).colwise().squaredNorm() / static_cast<double>(len))
+          .cwiseSqrt()
+          .transpose();
   out.report.spectrum = sp;
   out.projector = projector;
   std::ostringstream s;
@@ -457,10 +498,6 @@ void check_closed_loop_request(const IdentifyOptions& options, size_t runs, size
   if (!closed) return;
   if (options.model != IdentificationModel::kDifferential)
     throw UsageError("--closed-loop prepares the differential model's signals; drop --model");
-  if (options.estimator == IdentificationEstimator::kMl)
-    throw UsageError(
-        "--estimator ml models the noise of each sample's q and tau, which a closed-loop "
-        "projection mixes across samples: use ml on the direct run, or ols/wls after projection");
   if (references != runs)
     throw Error("closed-loop identification needs the reference of every run: " +
                 std::to_string(references) + " references for " + std::to_string(runs) + " runs");

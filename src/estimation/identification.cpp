@@ -453,6 +453,7 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
   check_closed_loop_request(options, runs.size(), references.size());
   Eigen::Index projected_dimensions = 0;  // Σ over runs and joints of the projector's rank
   std::vector<ProcessedRecord> prepared;  // every run's (maximum likelihood needs them all)
+  ProjectedRun projected;                 // the first run's projection (maximum likelihood)
   if (integral) {
     std::ostringstream m;
     m << "integral (energy) model, "
@@ -484,6 +485,10 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
       subtract_known_friction(model, options.known_friction, processed, raw);
       blocks.push_back(project_equations(raw, *cl.projector));
       projected_dimensions += static_cast<Eigen::Index>(n) * cl.report.rank;
+      if (i == 0) {
+        projected.projector = cl.projector;
+        projected.torque_remainder_std = cl.torque_remainder_std;
+      }
       result.closed_loop.push_back(std::move(cl.report));
     } else if (integral) {
       // The held-out cut-off selection fits the differential model; the integral model has its
@@ -594,10 +599,11 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
                              options.estimator == IdentificationEstimator::kWls, so);
   }
   if (ml) {
+    projected.dimensions = projected_dimensions;
     std::vector<int> columns;
     for (int c : data.kept) columns.push_back(result.base.base[static_cast<size_t>(c)]);
     maximum_likelihood_stage(model, options, coupling, blocks, prepared, screened.front().record,
-                             columns, W, fit, result.choices);
+                             columns, W, projected, fit, result.choices);
   }
   check_finite_estimate(fit.estimate, screened.front());
   result.estimate = std::move(fit.estimate);

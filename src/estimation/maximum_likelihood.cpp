@@ -4,11 +4,15 @@
 #include <iomanip>
 #include <sstream>
 
+#include <random>
+
 #include <ceres/ceres.h>
 #include <Eigen/Cholesky>
+#include <Eigen/SVD>
 
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
+#include "dynid/estimation/closed_loop.hpp"
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/statistics.hpp"
 #include "dynid/signal/lowpass_design.hpp"
@@ -72,8 +76,11 @@ struct SampleRows {
 };
 
 // Whitened residual L⁻¹·b of one sample, S = L·Lᵀ = J·diag(var_x)·Jᵀ + diag(var_tau) (seed 2
-// eqs. 15–16). Returns false when S is not positive definite.
-class SampleCost {
+// eqs. 15–16), and its analytic Jacobian (docs/methods/maximum_likelihood.md, "Jacobian"):
+// ∂(L⁻¹b)/∂θ_k = −L⁻¹W_k − Φ(L⁻¹·∂S/∂θ_k·L⁻ᵀ)·L⁻¹b, ∂S/∂θ_k = D_k·Aᵀ + A·D_kᵀ, A = J·diag(var_x),
+// D_k = ∂J/∂θ_k (row a: column k of row a's sensitivity), Φ = lower triangle with half the
+// diagonal (the derivative of a Cholesky factor). J is linear in θ, so this is exact.
+class SampleCost : public ceres::CostFunction {
  public:
   SampleCost(const EquationBlock& block, const Eigen::MatrixXd& sensitivity,
              const Eigen::VectorXd& var_x, const Eigen::VectorXd& var_tau_row, SampleRows rows)
@@ -81,35 +88,61 @@ class SampleCost {
         sensitivity_(sensitivity),
         var_x_(var_x),
         var_tau_row_(var_tau_row),
-        rows_(rows) {}
+        rows_(rows) {
+    set_num_residuals(static_cast<int>(rows.count));
+    mutable_parameter_block_sizes()->push_back(static_cast<int>(block.W.cols()));
+  }
 
-  template <typename Out>
-  bool whiten(const Eigen::Ref<const Eigen::VectorXd>& theta, Out&& residual,
-              Eigen::MatrixXd* whitened_rows = nullptr,
-              Eigen::VectorXd* whitened_y = nullptr) const {
-    const Eigen::Index r = rows_.count, n3 = var_x_.size();
-    const Eigen::VectorXd b =
-        block_.y.segment(rows_.first, r) - block_.W.middleRows(rows_.first, r) * theta;
+  // Returns false when S is not positive definite. jacobian: r × p, or null.
+  bool whiten(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> residual,
+              Eigen::MatrixXd* whitened_rows = nullptr, Eigen::VectorXd* whitened_y = nullptr,
+              Eigen::MatrixXd* jacobian = nullptr) const {
+    const Eigen::Index r = rows_.count, n3 = var_x_.size(), p = block_.W.cols();
+    const auto W = block_.W.middleRows(rows_.first, r);
+    const Eigen::VectorXd b = block_.y.segment(rows_.first, r) - W * theta;
     Eigen::MatrixXd J(r, n3);
     for (Eigen::Index a = 0; a < r; ++a) {
       J.row(a) = (sensitivity_.middleRows(n3 * (rows_.first + a), n3) * theta).transpose();
     }
-    Eigen::MatrixXd S = J * var_x_.asDiagonal() * J.transpose();
+    const Eigen::MatrixXd A = J * var_x_.asDiagonal();
+    Eigen::MatrixXd S = A * J.transpose();
     S.diagonal() += var_tau_row_.segment(rows_.first, r);
     const Eigen::LLT<Eigen::MatrixXd> llt(S);
     if (llt.info() != Eigen::Success) return false;
-    residual = llt.matrixL().solve(b);
-    if (whitened_rows) *whitened_rows = llt.matrixL().solve(block_.W.middleRows(rows_.first, r));
-    if (whitened_y) *whitened_y = llt.matrixL().solve(block_.y.segment(rows_.first, r));
+    const auto L = llt.matrixL();
+    residual = L.solve(b);
+    if (whitened_rows) *whitened_rows = L.solve(W);
+    if (whitened_y) *whitened_y = L.solve(block_.y.segment(rows_.first, r));
+    if (jacobian) {
+      jacobian->noalias() = -L.solve(W);
+      const Eigen::MatrixXd At = L.solve(A);  // L⁻¹A, r × n3
+      // D of every parameter side by side: column k·n3 + c of row a is ∂J(a, c)/∂θ_k.
+      Eigen::MatrixXd D(r, n3 * p);
+      for (Eigen::Index a = 0; a < r; ++a) {
+        const auto s = sensitivity_.middleRows(n3 * (rows_.first + a), n3);
+        for (Eigen::Index k = 0; k < p; ++k) D.block(a, k * n3, 1, n3) = s.col(k).transpose();
+      }
+      L.solveInPlace(D);  // L⁻¹D_k
+      Eigen::MatrixXd M(r, r);
+      for (Eigen::Index k = 0; k < p; ++k) {
+        M.noalias() = D.middleCols(k * n3, n3) * At.transpose();
+        M += M.transpose().eval();
+        M.diagonal() *= 0.5;
+        jacobian->col(k) -= M.triangularView<Eigen::Lower>() * residual;
+      }
+    }
     return true;
   }
 
-  bool operator()(double const* const* parameters, double* residuals) const {
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
     const Eigen::Map<const Eigen::VectorXd> theta(parameters[0], block_.W.cols());
     Eigen::Map<Eigen::VectorXd> out(residuals, rows_.count);
-    Eigen::VectorXd res(rows_.count);
-    if (!whiten(theta, res)) return false;
-    out = res;
+    if (jacobians == nullptr || jacobians[0] == nullptr) return whiten(theta, out);
+    Eigen::MatrixXd jac(rows_.count, block_.W.cols());
+    if (!whiten(theta, out, nullptr, nullptr, &jac)) return false;
+    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+        jacobians[0], rows_.count, block_.W.cols()) = jac;
     return true;
   }
 
@@ -131,13 +164,15 @@ Eigen::VectorXd squared_or_zero(const Eigen::VectorXd& std, int n, const char* n
   return std.array().square();
 }
 
-}  // namespace
+// The per-sample layout and noise variances of eq. 15 for `block`, after checking the sizes.
+struct Eq15 {
+  Eigen::VectorXd var_x;            // variances of q, q̇, q̈ of every joint (3n)
+  Eigen::VectorXd var_tau_row;      // torque variance of every row
+  std::vector<SampleRows> samples;  // the rows of each sample
+};
 
-Estimate maximum_likelihood(const EquationBlock& block, const Eigen::MatrixXd& sensitivity,
-                            const MeasurementNoise& noise, const Eigen::VectorXd& start,
-                            const EstimationOptions& estimation_options,
-                            const MaximumLikelihoodOptions& options,
-                            MaximumLikelihoodSummary* summary) {
+Eq15 eq15_setup(const EquationBlock& block, const Eigen::MatrixXd& sensitivity,
+                const MeasurementNoise& noise, const Eigen::VectorXd& start) {
   const Eigen::Index m = block.W.rows(), p = block.W.cols();
   const auto n = static_cast<int>(noise.tau.size());
   if (n < 1 || block.y.size() != m || block.sample.size() != m || block.group.size() != m ||
@@ -157,10 +192,13 @@ Estimate maximum_likelihood(const EquationBlock& block, const Eigen::MatrixXd& s
     throw Error("maximum likelihood: " + std::to_string(m) + " equations for " + std::to_string(p) +
                 " parameters; record a longer run");
   }
-  Eigen::VectorXd var_x(3 * n);
+  Eq15 out;
+  Eigen::VectorXd& var_x = out.var_x;
+  var_x.resize(3 * n);
   var_x << squared_or_zero(noise.q, n, "position"), squared_or_zero(noise.dq, n, "velocity"),
       squared_or_zero(noise.ddq, n, "acceleration");
-  Eigen::VectorXd var_tau_row(m);
+  Eigen::VectorXd& var_tau_row = out.var_tau_row;
+  var_tau_row.resize(m);
   for (Eigen::Index i = 0; i < m; ++i) {
     if (block.group[i] < 0 || block.group[i] >= n) {
       throw Error("maximum likelihood: row " + std::to_string(i) + " has joint " +
@@ -169,7 +207,7 @@ Estimate maximum_likelihood(const EquationBlock& block, const Eigen::MatrixXd& s
     }
     var_tau_row[i] = noise.tau[block.group[i]] * noise.tau[block.group[i]];
   }
-  std::vector<SampleRows> samples;
+  std::vector<SampleRows>& samples = out.samples;
   for (Eigen::Index i = 0; i < m; ++i) {
     if (i > 0 && block.sample[i] < block.sample[i - 1]) {
       throw Error("maximum likelihood: sample indices decrease at row " + std::to_string(i));
@@ -177,19 +215,53 @@ Estimate maximum_likelihood(const EquationBlock& block, const Eigen::MatrixXd& s
     if (i == 0 || block.sample[i] != block.sample[i - 1]) samples.push_back({i, 0});
     ++samples.back().count;
   }
+  return out;
+}
 
-  // Eq. 15 by Levenberg–Marquardt from the OLS start; central differences for the Jacobian (S
-  // depends on θ through B, eq. 16).
+}  // namespace
+
+Eigen::VectorXd maximum_likelihood_residual(const EquationBlock& block,
+                                            const Eigen::MatrixXd& sensitivity,
+                                            const MeasurementNoise& noise,
+                                            const Eigen::VectorXd& theta,
+                                            Eigen::MatrixXd* jacobian) {
+  const Eq15 eq = eq15_setup(block, sensitivity, noise, theta);
+  const Eigen::Index m = block.W.rows(), p = block.W.cols();
+  Eigen::VectorXd out(m);
+  if (jacobian) jacobian->resize(m, p);
+  for (const SampleRows& s : eq.samples) {
+    const SampleCost cost(block, sensitivity, eq.var_x, eq.var_tau_row, s);
+    Eigen::MatrixXd jac(s.count, p);
+    if (!cost.whiten(theta, out.segment(s.first, s.count), nullptr, nullptr,
+                     jacobian ? &jac : nullptr)) {
+      throw Error("maximum likelihood: the noise covariance of sample " +
+                  std::to_string(block.sample[s.first]) + " is not positive definite");
+    }
+    if (jacobian) jacobian->middleRows(s.first, s.count) = jac;
+  }
+  return out;
+}
+
+Estimate maximum_likelihood(const EquationBlock& block, const Eigen::MatrixXd& sensitivity,
+                            const MeasurementNoise& noise, const Eigen::VectorXd& start,
+                            const EstimationOptions& estimation_options,
+                            const MaximumLikelihoodOptions& options,
+                            MaximumLikelihoodSummary* summary) {
+  const Eq15 eq = eq15_setup(block, sensitivity, noise, start);
+  const Eigen::VectorXd& var_x = eq.var_x;
+  const Eigen::VectorXd& var_tau_row = eq.var_tau_row;
+  const std::vector<SampleRows>& samples = eq.samples;
+  const Eigen::Index m = block.W.rows(), p = block.W.cols();
+
+  // Eq. 15 by Levenberg–Marquardt from the OLS start, analytic Jacobian (SampleCost; S depends
+  // on θ through B, eq. 16).
   Eigen::VectorXd theta = start;
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
   for (const SampleRows& s : samples) {
-    auto* cost = new ceres::DynamicNumericDiffCostFunction<SampleCost, ceres::CENTRAL>(
-        new SampleCost(block, sensitivity, var_x, var_tau_row, s));
-    cost->AddParameterBlock(static_cast<int>(p));
-    cost->SetNumResiduals(static_cast<int>(s.count));
-    problem.AddResidualBlock(cost, nullptr, theta.data());
+    problem.AddResidualBlock(new SampleCost(block, sensitivity, var_x, var_tau_row, s), nullptr,
+                             theta.data());
   }
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
@@ -244,7 +316,14 @@ Estimate maximum_likelihood(const EquationBlock& block, const Eigen::MatrixXd& s
   }
   est.summary.estimator = EstimatorKind::kMaximumLikelihood;
   est.summary.passes = static_cast<int>(cs.iterations.size());
-  if (options.hac) apply_hac_covariance(est, Wt, et, block.sample, estimation_options);
+  if (options.projected_dimensions > 0) {
+    EquationBlock whitened = block;
+    whitened.W = Wt;
+    whitened.y = yt;
+    projected_statistics(est, whitened, options.projected_dimensions, false, estimation_options);
+  } else if (options.hac) {
+    apply_hac_covariance(est, Wt, et, block.sample, estimation_options);
+  }
   if (summary != nullptr) {
     summary->iterations = static_cast<int>(cs.iterations.size());
     summary->initial_cost = cs.initial_cost;
@@ -255,6 +334,21 @@ Estimate maximum_likelihood(const EquationBlock& block, const Eigen::MatrixXd& s
   }
   return est;
 }
+
+namespace {
+
+// Processed-signal noise from raw σ_q, σ_τ and the white-noise gains g_k of k derivatives.
+MeasurementNoise scaled_noise(const Eigen::VectorXd& sq, const Eigen::VectorXd& st, double g0,
+                              double g1, double g2) {
+  MeasurementNoise out;
+  out.q = g0 * sq;
+  out.dq = g1 * sq;
+  out.ddq = g2 * sq;
+  out.tau = g0 * st;
+  return out;
+}
+
+}  // namespace
 
 MeasurementNoise processed_noise(const SensorNoise& given, const SignalOptions& signal,
                                  const ProcessedRecord& processed, const JointRecord& raw,
@@ -299,11 +393,7 @@ MeasurementNoise processed_noise(const SensorNoise& given, const SignalOptions& 
   const SosFilter* f = filtered ? &filter : nullptr;
   const double g0 = white_noise_gain(f, 0, rate), g1 = white_noise_gain(f, 1, rate),
                g2 = white_noise_gain(f, 2, rate);
-  MeasurementNoise out;
-  out.q = g0 * sq;
-  out.dq = g1 * sq;
-  out.ddq = g2 * sq;
-  out.tau = g0 * st;
+  const MeasurementNoise out = scaled_noise(sq, st, g0, g1, g2);
   std::ostringstream s;
   s << std::setprecision(3) << "raw std q [" << sq.transpose() << "] " << source_q << ", tau ["
     << st.transpose() << "] " << source_tau << "; through the "
@@ -313,11 +403,60 @@ MeasurementNoise processed_noise(const SensorNoise& given, const SignalOptions& 
   return out;
 }
 
+MeasurementNoise projected_noise(const SensorNoise& given, const SignalProjector& projector,
+                                 double ts, const ProcessedRecord& processed,
+                                 const Eigen::VectorXd& torque_remainder_std, std::string& how) {
+  const Eigen::Index n = processed.record.q.cols(), len = projector.samples();
+  if (processed.record.q.rows() != len || torque_remainder_std.size() != n || !(ts > 0.0))
+    throw Error(
+        "projected_noise: the projector, the processed record and the remainders differ "
+        "in size");
+  Eigen::VectorXd sq = given.q.size() ? given.q : processed.position_noise_std;
+  Eigen::VectorXd st = given.tau.size() ? given.tau : torque_remainder_std;
+  if (sq.size() != n || st.size() != n || !sq.allFinite() || !st.allFinite() ||
+      (sq.array() < 0.0).any())
+    throw Error("the noise needs " + std::to_string(n) +
+                " finite standard deviations >= 0 for q and tau");
+  for (Eigen::Index j = 0; j < n; ++j)
+    if (!(st[j] > 0.0))
+      throw Error("maximum likelihood: the torque noise of joint " + std::to_string(j + 1) +
+                  " is 0 after the projection; give --noise-std tau=S or --noise FILE");
+  // An orthonormal basis U of P's range: P applied to a fixed-seed Gaussian matrix has rank d.
+  const Eigen::Index d = projector.rank(), cols = std::min<Eigen::Index>(d + 8, len);
+  std::mt19937_64 rng(13);
+  std::normal_distribution<double> z;
+  Eigen::MatrixXd Z(len, cols);
+  for (Eigen::Index c = 0; c < cols; ++c)
+    for (Eigen::Index k = 0; k < len; ++k) Z(k, c) = z(rng);
+  const Eigen::BDCSVD<Eigen::MatrixXd> svd(projector.project(Z), Eigen::ComputeThinU);
+  const Eigen::MatrixXd U = svd.matrixU().leftCols(std::min(d, cols));
+  const Eigen::Index inner = len - 2;
+  if (inner < 1) throw Error("projected_noise: fewer than 3 samples");
+  const Eigen::MatrixXd d1 = (U.bottomRows(inner) - U.topRows(inner)) / (2.0 * ts);
+  const Eigen::MatrixXd d2 =
+      (U.bottomRows(inner) - 2.0 * U.middleRows(1, inner) + U.topRows(inner)) / (ts * ts);
+  const double g0 = std::sqrt(U.squaredNorm() / static_cast<double>(len));
+  const double g1 = std::sqrt(d1.squaredNorm() / static_cast<double>(inner));
+  const double g2 = std::sqrt(d2.squaredNorm() / static_cast<double>(inner));
+  const MeasurementNoise out = scaled_noise(sq, st, g0, g1, g2);
+  std::ostringstream s;
+  s << std::setprecision(3) << "std q [" << sq.transpose() << "] "
+    << (given.q.size() ? "given" : "of the remainder q - q^ (taken as white)") << ", tau ["
+    << st.transpose() << "] "
+    << (given.tau.size() ? "given" : "of the remainder tau - tau^ (taken as white)")
+    << "; through the projection (" << d << " of " << len
+    << " dimensions per channel) and its derivatives: q x " << g0 << ", dq x " << g1 << ", ddq x "
+    << g2 << ", tau x " << g0;
+  how = s.str();
+  return out;
+}
+
 void maximum_likelihood_stage(const Model& model, const IdentifyOptions& options, bool coupling,
                               const std::vector<EquationBlock>& blocks,
                               const std::vector<ProcessedRecord>& processed,
                               const JointRecord& first_raw, const std::vector<int>& columns,
-                              const EquationBlock& stacked, BlockEstimate& fit,
+                              const EquationBlock& stacked, const ProjectedRun& projected,
+                              BlockEstimate& fit,
                               std::vector<std::pair<std::string, std::string>>& choices) {
   if (blocks.size() != processed.size() || blocks.empty())
     throw Error("maximum_likelihood_stage: one processed record per block is needed");
@@ -337,13 +476,18 @@ void maximum_likelihood_stage(const Model& model, const IdentifyOptions& options
   }
   std::string how;
   const MeasurementNoise noise =
-      processed_noise(options.noise, options.signal, processed.front(), first_raw, how);
+      projected.projector
+          ? projected_noise(options.noise, *projected.projector, 1.0 / processed.front().rate_hz,
+                            processed.front(), projected.torque_remainder_std, how)
+          : processed_noise(options.noise, options.signal, processed.front(), first_raw, how);
   choices.emplace_back("noise", how);
   EstimationOptions eo;
   eo.confidence_level = options.confidence_level;
   eo.names = stacked.columns;
   MaximumLikelihoodSummary summary;
-  fit.estimate = maximum_likelihood(stacked, sensitivity, noise, fit.estimate.x, eo, {}, &summary);
+  MaximumLikelihoodOptions mo;
+  mo.projected_dimensions = projected.projector ? projected.dimensions : 0;
+  fit.estimate = maximum_likelihood(stacked, sensitivity, noise, fit.estimate.x, eo, mo, &summary);
   const Eigen::VectorXd e = stacked.y - stacked.W * fit.estimate.x;
   fit.residual = e;
   fit.relative_error = e.norm() / std::max(stacked.y.norm(), 1e-300);
@@ -363,6 +507,9 @@ void maximum_likelihood_stage(const Model& model, const IdentifyOptions& options
     << summary.iterations << " iterations, " << summary.termination << "); variance factor "
     << summary.variance_factor << " (about 1 when the noise is right); "
     << fit.estimate.covariance_kind << " covariance on the whitened rows";
+  if (mo.projected_dimensions > 0)
+    c << " (" << mo.projected_dimensions << " dimensions spanned, Student-t intervals with "
+      << fit.estimate.degrees_of_freedom << " degrees of freedom)";
   fit.covariance_choice = c.str();
 }
 

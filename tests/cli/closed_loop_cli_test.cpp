@@ -81,6 +81,13 @@ TEST(ClosedLoopCli, ProjectionSpectralAndRepeatWriteTheirJson) {
   EXPECT_NEAR(j["closed_loop"]["spectrum"]["f0_hz"].get<double>(), 0.2, 1e-9);
   EXPECT_EQ(j["closed_loop"]["spectrum"]["lines"], nlohmann::json({1, 2, 3, 4}));
   EXPECT_EQ(j["closed_loop"]["dimensions_per_channel"], 9);
+  // validate says that a closed-loop result is checked against the measured, unprojected torques.
+  r = run("validate --robot planar2 --params " + path("spectral.json") + " --data " + data +
+          " --json " + path("validate_spectral.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  j = load(path("validate_spectral.json"));
+  EXPECT_NE(j["choices"]["closed_loop"].get<std::string>().find("not projected"),
+            std::string::npos);
 
   r = run("identify --robot planar2 --data " + data +
           " --estimator ml --noise-std q=1e-3,tau=0.1 --out " + path("ml.json"));
@@ -89,6 +96,17 @@ TEST(ClosedLoopCli, ProjectionSpectralAndRepeatWriteTheirJson) {
   EXPECT_NE(j["choices"]["noise"].get<std::string>().find("given"), std::string::npos);
   EXPECT_NE(j["choices"]["covariance"].get<std::string>().find("maximum likelihood"),
             std::string::npos);
+
+  // After the spectral projection (period given), with the noise of the projected signals.
+  r = run("identify --robot planar2 --data " + data +
+          " --closed-loop spectral --f0 0.2 --estimator ml --out " + path("spectral_ml.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  j = load(path("spectral_ml.json"));
+  EXPECT_NE(j["choices"]["noise"].get<std::string>().find("through the projection"),
+            std::string::npos);
+  EXPECT_NE(j["choices"]["covariance"].get<std::string>().find("degrees of freedom"),
+            std::string::npos);
+  EXPECT_NE(j["choices"]["period"].get<std::string>().find("given: 5 s"), std::string::npos);
 }
 
 // One `error:` line, the exit code, and no result file.
@@ -131,8 +149,11 @@ TEST(ClosedLoopCli, BadInputIsOneErrorLine) {
   expect_error(id + path("no_qr.csv") + " --repeat periods", 1,
                "error: --repeat periods finds the period from the reference");
   expect_error(id + data + " --repeat runs", 1, "error: --repeat needs at least 2 runs");
-  expect_error(id + data + " --closed-loop projection --estimator ml", 2,
-               "error: --estimator ml models the noise of each sample");
+  expect_error(id + data + " --f0 0.2", 2, "error: --period/--f0 give the reference's period");
+  expect_error(id + data + " --closed-loop spectral --f0 0.2 --period 5", 2,
+               "error: give one of --period S or --f0 HZ");
+  expect_error(id + data + " --closed-loop spectral --period 3", 1,
+               "error: qr1 does not repeat with --period 3 s");
 }
 
 }  // namespace

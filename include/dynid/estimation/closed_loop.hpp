@@ -22,6 +22,9 @@ struct ClosedLoopRun {
   /// The same projection for the regressor columns (project_equations).
   std::shared_ptr<const SignalProjector> projector;
   ClosedLoopReport report;  ///< what was chosen and found
+  /// Per joint std of τ − τ̂ on the kept samples [N·m or N]: the torque noise the projection
+  /// removes (maximum likelihood's torque noise after a projection when none is given).
+  Eigen::VectorXd torque_remainder_std;
 };
 
 /// The prepare stage of closed-loop identification. Projection: project_on_reference() with the
@@ -58,7 +61,7 @@ std::string projected_statistics(Estimate& estimate, const EquationBlock& block,
                                  const EstimationOptions& options);
 
 /// Refuses what identify() cannot do with options.closed_loop: another model than the
-/// differential one, the ML estimator, or not one reference per run (none needed without a
+/// differential one, or not one reference per run (none needed without a
 /// closed-loop method). Throws dynid::UsageError / dynid::Error naming the fix.
 void check_closed_loop_request(const IdentifyOptions& options, size_t runs, size_t references);
 

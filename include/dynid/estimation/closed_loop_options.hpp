@@ -33,6 +33,14 @@ struct ClosedLoopIdOptions {
   /// Spectral: a harmonic of f0 whose reference amplitude exceeds this fraction of the largest
   /// harmonic of the same joint is a line of the excitation; the band ends at the highest line.
   double line_fraction = 1e-3;
+  /// Spectral: the reference's period [s] as the user knows it (`--period`, `--f0`); 0 = detected
+  /// from qr, which must then repeat exactly. A given period must be a whole number of samples
+  /// (to 1e-6 of one) with two periods in the run, and qr must repeat with it to
+  /// `given_period_tolerance` of its range.
+  double period = 0.0;
+  /// Spectral with a given period: largest |qr(t + T) − qr(t)| accepted, as a fraction of each
+  /// joint's range (a logged reference is rounded; a larger mismatch means the period is wrong).
+  double given_period_tolerance = 1e-3;
   /// The torque logged at t acts at t + offset [s] (SignalOptions::torque_time_offset; identify()
   /// copies it): re-interpolated before the projection.
   double torque_time_offset = 0.0;

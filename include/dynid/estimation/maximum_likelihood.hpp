@@ -1,5 +1,6 @@
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -9,6 +10,7 @@
 #include "dynid/estimation/estimate.hpp"
 #include "dynid/estimation/identification.hpp"
 #include "dynid/estimation/pipeline.hpp"
+#include "dynid/estimation/projection.hpp"
 #include "dynid/model/model.hpp"
 #include "dynid/regressor/parameter_layout.hpp"
 
@@ -30,6 +32,11 @@ struct MaximumLikelihoodOptions {
   /// Intervals from a Newey–West sandwich over samples on the whitened scores (as identify()'s
   /// default), the information-based ones kept as std_dev_white; false: information only.
   bool hac = true;
+  /// > 0: the rows are projected signals (closed loop) spanning this many dimensions in all
+  /// (Σ over runs and joints of the projector's rank); the intervals then come from
+  /// projected_statistics() on the whitened rows with that many degrees of freedom less the
+  /// parameters (no HAC: projected residuals are smooth by construction).
+  Eigen::Index projected_dimensions = 0;
 };
 
 /// What the maximum-likelihood solve did (Ceres style).
@@ -75,6 +82,18 @@ Estimate maximum_likelihood(const EquationBlock& block, const Eigen::MatrixXd& s
                             const MaximumLikelihoodOptions& options = {},
                             MaximumLikelihoodSummary* summary = nullptr);
 
+/// Eq. 15's whitened residuals at θ (seed 2 eqs. 15–16), in the block's row order: per sample k,
+/// L_k⁻¹·b_k with b_k = τ_k − W_k·θ and S_k = L_k·L_kᵀ = B_k σ² B_kᵀ, so that eq. 15's cost is
+/// ½‖result‖². With `jacobian`, also their exact derivative with respect to θ (rows × p; J is
+/// linear in θ, docs/methods/maximum_likelihood.md "Jacobian"), the one maximum_likelihood()
+/// hands to Ceres. Arguments as maximum_likelihood() (θ for `start`). Throws dynid::Error as
+/// maximum_likelihood(), and when some S_k is not positive definite.
+Eigen::VectorXd maximum_likelihood_residual(const EquationBlock& block,
+                                            const Eigen::MatrixXd& sensitivity,
+                                            const MeasurementNoise& noise,
+                                            const Eigen::VectorXd& theta,
+                                            Eigen::MatrixXd* jacobian = nullptr);
+
 /// Noise of the processed signals (MeasurementNoise) from raw sensor noise: σ_q·g₀, σ_q·g₁,
 /// σ_q·g₂ and σ_τ·g₀, g_k = white_noise_gain() of identify()'s zero-phase filter (as preprocess()
 /// designs it from `signal` and the run's cut-off, unit DC gain) followed by k central
@@ -86,16 +105,38 @@ MeasurementNoise processed_noise(const SensorNoise& given, const SignalOptions& 
                                  const ProcessedRecord& processed, const JointRecord& raw,
                                  std::string& how);
 
+/// Noise of closed-loop projected signals (prepare_closed_loop()) for maximum_likelihood(). A white
+/// noise of std σ through the orthogonal rank-d projector P of N samples has per-sample variance
+/// σ²·P_tt, σ²·d/N on average; q̂' and q̂'' are the derivatives of the projected q, so their noise
+/// has on average σ²·‖DᵏU‖²_F/N, U an orthonormal basis of P's range (from P applied to a
+/// fixed-seed Gaussian matrix) and D central differences at `ts` [s] (exact to (hω·ts)²/6 on a
+/// band far below Nyquist). Raw σ from `given` where set, else the remainders as white noise:
+/// σ_q = processed.position_noise_std (q − q̂), σ_τ = torque_remainder_std (τ − τ̂).
+/// docs/methods/maximum_likelihood.md "After a projection". `how` receives one line. Throws
+/// dynid::Error when σ_τ is not > 0 or the sizes do not match.
+MeasurementNoise projected_noise(const SensorNoise& given, const SignalProjector& projector,
+                                 double ts, const ProcessedRecord& processed,
+                                 const Eigen::VectorXd& torque_remainder_std, std::string& how);
+
+/// The closed-loop preparation maximum_likelihood_stage() needs; no projector: a direct run.
+struct ProjectedRun {
+  std::shared_ptr<const SignalProjector> projector;  ///< the first run's projection
+  Eigen::VectorXd torque_remainder_std;              ///< its τ − τ̂ std per joint [N·m or N]
+  Eigen::Index dimensions = 0;  ///< Σ over runs and joints of the projector's rank
+};
+
 /// The estimate stage of identify() with IdentificationEstimator::kMl: maximum_likelihood() on
 /// the stacked equations `stacked` (data-identifiable base columns `columns` of the layout) from
 /// fit's OLS estimate, with the sensitivity of every run's block (`blocks`, `processed` in run
-/// order) and processed_noise() of the first run; fit's estimate, residuals and covariance choice
+/// order) and processed_noise() of the first run (after a closed-loop projection, `projected`:
+/// projected_noise() and projected intervals); fit's estimate, residuals and covariance choice
 /// are replaced and the noise used is appended to `choices`. Throws as maximum_likelihood().
 void maximum_likelihood_stage(const Model& model, const IdentifyOptions& options, bool coupling,
                               const std::vector<EquationBlock>& blocks,
                               const std::vector<ProcessedRecord>& processed,
                               const JointRecord& first_raw, const std::vector<int>& columns,
-                              const EquationBlock& stacked, BlockEstimate& fit,
+                              const EquationBlock& stacked, const ProjectedRun& projected,
+                              BlockEstimate& fit,
                               std::vector<std::pair<std::string, std::string>>& choices);
 
 }  // namespace dynid
