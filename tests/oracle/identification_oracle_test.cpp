@@ -1,6 +1,7 @@
 // End-to-end identification on data whose torques come from KDL's RNE (another implementation),
 // not from dynid's regressor: noise-free recovery, and confidence-interval coverage with noise.
 #include <cmath>
+#include <iostream>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -204,8 +205,11 @@ TEST(IdentificationOracle, ResidualAutocorrelationIsMeasuredAndWarned) {
 // 60 < 61 and reports YY1R with σ = null". Every joint of the puma560 moves (multi-sine), KDL's
 // torques with a little noise, velocities and accelerations derived from the sampled q as a user's
 // log gives them: every base parameter is data-identifiable and has a finite σ.
-TEST(IdentificationOracle, SixJointKdlRunWhereEveryJointMovesHasFullDataRank) {
-  const Model model = load_robot("puma560");
+class SixJointKdl : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(SixJointKdl, RunWhereEveryJointMovesHasFullDataRank) {
+  const std::string name = GetParam();
+  const Model model = load_robot(name == "puma560" ? name : std::string(DYNID_SOURCE_DIR) + name);
   JointRecord r = excite(model.dof(), 20.0, 200.0, 8);
   const Eigen::MatrixXd exact = kdl_torques(model, r);
   r.dq.resize(0, 0);
@@ -217,6 +221,8 @@ TEST(IdentificationOracle, SixJointKdlRunWhereEveryJointMovesHasFullDataRank) {
     run.tau = exact;
     for (Eigen::Index i = 0; i < run.tau.size(); ++i) run.tau.data()[i] += sigma * noise(rng);
     const IdentificationResult res = identify(model, run, IdentifyOptions());
+    std::cout << name << " torque noise " << sigma << ": data rank " << res.data_rank << " of "
+              << res.rank << "\n";
     EXPECT_EQ(res.data_rank, res.rank) << "torque noise " << sigma;
     EXPECT_TRUE(res.not_excited.empty());
     ASSERT_EQ(res.estimate.std_dev.size(), res.rank);
@@ -227,6 +233,9 @@ TEST(IdentificationOracle, SixJointKdlRunWhereEveryJointMovesHasFullDataRank) {
     for (const auto& w : res.warnings) EXPECT_EQ(w.find("rank"), std::string::npos) << w;
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Robots, SixJointKdl,
+                         ::testing::Values("puma560", "/examples/staubli-tx40/tx40.yaml"));
 
 }  // namespace
 }  // namespace dynid
