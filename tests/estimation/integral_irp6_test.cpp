@@ -4,8 +4,9 @@
 // IRp-6 logger) with encoder and torque noise. Identified with short and long integrals and with
 // the differential model; the truth must lie inside the 99.9 % intervals of the short-integral
 // and differential estimates; seed 1 found long integrals worse than short ones, and here they are
-// better (see the second test).
-// (Several runs stacked into one identification is issue 11 item 2, not here.)
+// better (see the second test). Which sensor error reverses that, and the example's pipeline with
+// the IRp-6's sensors: the IntegralIrp6Example tests and the on-demand study at the end
+// (docs/methods/estimation.md §7a).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
