@@ -369,7 +369,13 @@ void hold_still_joints(const Model& model, ProcessedRecord& p,
   for (Eigen::Index j = 0; j < r.dq.cols(); ++j) {
     const double sigma = j < p.velocity_noise_std.size() ? p.velocity_noise_std[j] : 0.0;
     const double peak = r.dq.col(j).cwiseAbs().maxCoeff();
-    if (!(sigma > 0.0) || peak >= kStillNoiseMultiple * sigma) continue;
+    // A quantised encoder that never left its count has no measurable noise (sigma = 0), and the
+    // filtered velocity of its constant position is round-off, not motion.
+    const double range = r.q.col(j).maxCoeff() - r.q.col(j).minCoeff();
+    const bool constant = range <= 1e-12 * std::max(1.0, r.q.col(j).cwiseAbs().maxCoeff());
+    if (!constant && (!(sigma > 0.0) || peak >= kStillNoiseMultiple * sigma)) continue;
+    // The integral model's friction integrals read the steps Δq: round-off steps are no motion.
+    if (constant) r.q.col(j).setConstant(r.q.col(j).mean());
     r.dq.col(j).setZero();
     r.ddq.col(j).setZero();
     if (p.moving_positive.size()) {
@@ -377,8 +383,12 @@ void hold_still_joints(const Model& model, ProcessedRecord& p,
       p.moving_negative.col(j).setZero();
     }
     std::ostringstream w;
-    w << std::setprecision(3) << model.joints[static_cast<size_t>(j)].name << " (max|dq| " << peak
-      << " < " << kStillNoiseMultiple << " x noise std " << sigma << ")";
+    w << std::setprecision(3) << model.joints[static_cast<size_t>(j)].name;
+    if (constant) {
+      w << " (position constant)";
+    } else {
+      w << " (max|dq| " << peak << " < " << kStillNoiseMultiple << " x noise std " << sigma << ")";
+    }
     still += (still.empty() ? "" : ", ") + w.str();
   }
   if (!still.empty()) {

@@ -1,6 +1,7 @@
 // End-to-end identification on data whose torques come from KDL's RNE (another implementation),
 // not from dynid's regressor: noise-free recovery, and confidence-interval coverage with noise.
 #include <cmath>
+#include <iostream>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -199,6 +200,44 @@ TEST(IdentificationOracle, ResidualAutocorrelationIsMeasuredAndWarned) {
   }
   EXPECT_TRUE(warned);
 }
+
+// Issue 11 item 3: "on a KDL-simulated 6-joint run where every joint moves, identify warns rank
+// 60 < 61 and reports YY1R with σ = null". Every joint of the puma560 (58 base parameters) and of
+// the TX40 (61 with its coupled wrist) moves (multi-sine), KDL's torques with and without noise,
+// velocities and accelerations derived from the sampled q as a user's log gives them: every base
+// parameter is data-identifiable and has a finite σ. (A guard only: these runs give full rank
+// with or without estimate_block's unit-norm re-solve; the reported run was not reproduced.)
+class SixJointKdl : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(SixJointKdl, RunWhereEveryJointMovesHasFullDataRank) {
+  const std::string name = GetParam();
+  const Model model = load_robot(name == "puma560" ? name : std::string(DYNID_SOURCE_DIR) + name);
+  JointRecord r = excite(model.dof(), 10.0, 200.0, 8);
+  const Eigen::MatrixXd exact = kdl_torques(model, r);
+  r.dq.resize(0, 0);
+  r.ddq.resize(0, 0);
+  std::mt19937 rng(9);
+  std::normal_distribution<double> noise;
+  for (const double sigma : {0.0, 0.05}) {
+    JointRecord run = r;
+    run.tau = exact;
+    for (Eigen::Index i = 0; i < run.tau.size(); ++i) run.tau.data()[i] += sigma * noise(rng);
+    const IdentificationResult res = identify(model, run, IdentifyOptions());
+    std::cout << name << " torque noise " << sigma << ": data rank " << res.data_rank << " of "
+              << res.rank << "\n";
+    EXPECT_EQ(res.data_rank, res.rank) << "torque noise " << sigma;
+    EXPECT_TRUE(res.not_excited.empty());
+    ASSERT_EQ(res.estimate.std_dev.size(), res.rank);
+    for (int i = 0; i < res.rank; ++i) {
+      EXPECT_TRUE(std::isfinite(res.estimate.std_dev[i]) && res.estimate.std_dev[i] > 0.0)
+          << res.names[i] << " σ = " << res.estimate.std_dev[i];
+    }
+    for (const auto& w : res.warnings) EXPECT_EQ(w.find("rank"), std::string::npos) << w;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Robots, SixJointKdl,
+                         ::testing::Values("puma560", "/examples/staubli-tx40/tx40.yaml"));
 
 }  // namespace
 }  // namespace dynid
