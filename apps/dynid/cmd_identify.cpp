@@ -587,6 +587,10 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
       records.push_back(read_joint_record(o.runs[i], model, file, &read));
     }
     progress.update((steps - 1.0) / steps, "filtering and estimating");
+    // The ML iterations fill the last step of the line.
+    options.progress = [&progress, steps](double fraction, const std::string& what) {
+      progress.update((steps - 1.0 + fraction) / steps, what);
+    };
     for (const auto& f : o.friction_known) {
       const IdentifiedResultFile known = read_identification_result(f);
       require_same_robot(known.robot, model.name, "--friction-known '" + f + "'",
@@ -607,6 +611,7 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
                                    o.repeat == "runs" ? RepeatOver::kRuns : RepeatOver::kPeriods);
     }
     progress.finish();
+    options.progress = nullptr;  // it refers to this scope's line
     for (size_t i = 0; i < result.runs.size(); ++i) result.runs[i].file = o.runs[i];
   }
   echo_choices("identify", read, result.choices);

@@ -108,8 +108,8 @@ TEST_F(ReportCli, EveryResultKindRendersInChromium) {
 }
 
 // The kinds that come from simulated experiments, in one page (one Chromium start): the integral
-// model's energy fit (seed 1 Fig. 5), the gravity and friction experiments, validation by
-// simulation and the controller comparison. Native plant, short runs.
+// model's energy fit (seed 1 Fig. 5), the gravity, friction and decoupled experiments, validation
+// by simulation and the controller comparison. Native plant, short runs.
 TEST_F(ReportCli, ExperimentSimulationAndControlKindsRenderInChromium) {
   // One 4 s period of two harmonics per joint at 200 Hz (as tests/cli/control_cli_test.cpp).
   {
@@ -170,6 +170,10 @@ TEST_F(ReportCli, ExperimentSimulationAndControlKindsRenderInChromium) {
             path(name + ".csv") + " --out " + path(name + ".json"));
     ASSERT_EQ(r.code, 0) << r.err;
   }
+  // The joint-decoupled model (eqs. 21–22) of the shoulder from the same one-joint run.
+  r = run("identify --robot planar2 --model decoupled --joint 1 --data " + path("friction.csv") +
+          " --out " + path("decoupled.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
   r = run("simulate --robot planar2 --trajectory " + path("traj.csv") + " --out " + path("ct.csv") +
           " --periods 2 --controller computed-torque --params " + path("id.json") + noise);
   ASSERT_EQ(r.code, 0) << r.err;
@@ -181,14 +185,14 @@ TEST_F(ReportCli, ExperimentSimulationAndControlKindsRenderInChromium) {
           path("traj.csv") + " --engine native --json " + path("cmp.json"));
   ASSERT_EQ(r.code, 0) << r.err;
   r = run("report --in " + path("integral.json") + " --in " + path("gravity.json") + " --in " +
-          path("friction.json") + " --in " + path("valsim.json") + " --in " + path("cmp.json") +
-          " --out " + path("kinds.html"));
+          path("friction.json") + " --in " + path("decoupled.json") + " --in " +
+          path("valsim.json") + " --in " + path("cmp.json") + " --out " + path("kinds.html"));
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string page = testing::slurp(path("kinds.html"));
   EXPECT_NE(page.find("Energy over the intervals"), std::string::npos);
   EXPECT_NE(page.find("Tracking error RMS per joint"), std::string::npos);
-  expect_renders(path("kinds.html"), {"identify", "experiment", "experiment", "validate-simulation",
-                                      "compare-control"});
+  expect_renders(path("kinds.html"), {"identify", "experiment", "experiment", "experiment",
+                                      "validate-simulation", "compare-control"});
 }
 
 TEST_F(ReportCli, BadInputsGiveOneErrorLineAndNoPage) {

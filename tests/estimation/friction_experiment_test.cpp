@@ -169,7 +169,7 @@ TEST(IdentifiedModel, AsymmetricFrictionIsPredictedPerDirection) {
   RneaOptions rigid;
   rigid.joint_terms = false;
   const Eigen::Vector2d q(0.3, -0.7), ddq(1.0, -2.0);
-  for (const Eigen::Vector2d dq : {Eigen::Vector2d(0.6, -0.4), Eigen::Vector2d(-0.9, 1.2)}) {
+  for (const Eigen::Vector2d& dq : {Eigen::Vector2d(0.6, -0.4), Eigen::Vector2d(-0.9, 1.2)}) {
     const Eigen::Vector2d friction = rnea(m, q, dq, ddq) - rnea(m, q, dq, ddq, rigid);
     for (int j = 0; j < 2; ++j) {
       const Eigen::Vector4d& f = j == 0 ? f1 : f2;

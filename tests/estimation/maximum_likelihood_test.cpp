@@ -160,12 +160,26 @@ TEST(MaximumLikelihood, NoiseFreeRunGivesTheTruthFromAPerturbedStart) {
   const MeasuredRun run = measured_run(m, noise_of_size(0.0), 1);
   const Eigen::VectorXd start = 1.1 * run.truth;
   MaximumLikelihoodSummary summary;
-  const Estimate e =
-      maximum_likelihood(run.block, run.sensitivity, noise_of_size(1e-3), start, {}, {}, &summary);
+  // Progress: one call per Levenberg–Marquardt iteration, fractions in [0, 1], never decreasing.
+  MaximumLikelihoodOptions options;
+  int calls = 0;
+  double last = -1.0;
+  bool monotone = true;
+  options.progress = [&](double fraction, const std::string& what) {
+    ++calls;
+    monotone = monotone && fraction >= last && fraction <= 1.0 &&
+               what.find("maximum likelihood iteration") == 0;
+    last = fraction;
+  };
+  const Estimate e = maximum_likelihood(run.block, run.sensitivity, noise_of_size(1e-3), start, {},
+                                        options, &summary);
   for (int i = 0; i < run.base.rank; ++i) {
     EXPECT_NEAR(e.x[i], run.truth[i], 1e-6 * (1.0 + std::abs(run.truth[i]))) << run.base.names[i];
   }
   EXPECT_EQ(e.summary.estimator, EstimatorKind::kMaximumLikelihood);
+  EXPECT_EQ(calls, summary.iterations);
+  EXPECT_GT(calls, 1);
+  EXPECT_TRUE(monotone);
 }
 
 // The analytic Jacobian of eq. 15's whitened residual (the one handed to Ceres) against central

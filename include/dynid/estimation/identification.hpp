@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include "dynid/common/progress.hpp"
 #include "dynid/estimation/closed_loop_options.hpp"
 #include "dynid/estimation/estimate.hpp"
 #include "dynid/estimation/integral_options.hpp"
@@ -115,6 +116,8 @@ struct IdentifyOptions {
   ClosedLoopIdOptions closed_loop;
   /// With the ML estimator: the raw sensor noise (empty entries estimated from the data).
   SensorNoise noise;
+  /// Told how the long stages get on (today the ML iterations; common/progress.hpp); may be empty.
+  ProgressCallback progress;
 };
 
 /// One run of a (possibly several-run) identification.

@@ -6,6 +6,8 @@
 
 #include <Eigen/Core>
 
+#include "dynid/common/progress.hpp"
+
 #include "dynid/estimation/equation_block.hpp"
 #include "dynid/estimation/estimate.hpp"
 #include "dynid/estimation/identification.hpp"
@@ -37,6 +39,9 @@ struct MaximumLikelihoodOptions {
   /// projected_statistics() on the whitened rows with that many degrees of freedom less the
   /// parameters (no HAC: projected residuals are smooth by construction).
   Eigen::Index projected_dimensions = 0;
+  /// Called after each Levenberg–Marquardt iteration with iteration / max_iterations (the solve
+  /// usually ends earlier) and the cost (common/progress.hpp); may be empty.
+  ProgressCallback progress;
 };
 
 /// What the maximum-likelihood solve did (Ceres style).
