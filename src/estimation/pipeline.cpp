@@ -157,11 +157,22 @@ DataIdentifiability data_identifiability(const EquationBlock& block,
   DataIdentifiability out;
   out.tolerance = options.relative_tolerance;
   out.absorbs.clear();
-  // Column scaling: a zero column (no data at all) stays zero and is never kept.
+  // Column scaling: a zero column (no data at all) stays zero and is never kept. So does a column
+  // that is zero up to round-off (below kRoundOffColumn × the largest column norm): unit scaling
+  // would blow it up into an independent direction. Seen on a joint held still: the kinetic-energy
+  // columns of its link that cancel analytically came out 1e-17 and 1e-33, not 0, and were
+  // "estimated" with σ ~ 1e19. Columns of one regressor differ by the motion's and geometry's
+  // scale, orders of magnitude, never twelve.
+  constexpr double kRoundOffColumn = 1e-12;
   const Eigen::VectorXd norms = block.W.colwise().norm().transpose();
+  double largest = 0.0;
+  for (Eigen::Index c = 0; c < p; ++c) {
+    if (std::isfinite(norms[c])) largest = std::max(largest, norms[c]);
+  }
   std::vector<int> nonzero;
   for (Eigen::Index c = 0; c < p; ++c) {
-    if (norms[c] > 0.0 && std::isfinite(norms[c])) nonzero.push_back(static_cast<int>(c));
+    if (norms[c] > kRoundOffColumn * largest && std::isfinite(norms[c]))
+      nonzero.push_back(static_cast<int>(c));
   }
   if (nonzero.empty()) {
     for (Eigen::Index c = 0; c < p; ++c) out.not_excited.push_back(static_cast<int>(c));
