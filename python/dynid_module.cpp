@@ -97,6 +97,22 @@ JointRecord record_of(const Model& model, const Eigen::VectorXd& t, const Sample
 
 // identify()/validate() options from keyword arguments; an unknown key is an error naming the
 // valid ones.
+// The `estimator` keyword ('ols', 'wls' or 'rls') as identify's or payload's enum.
+template <class Estimator>
+Estimator estimator_of(const std::string& name, Estimator ols, Estimator wls, Estimator rls) {
+  if (name == "ols") return ols;
+  if (name == "wls") return wls;
+  if (name == "rls") return rls;
+  throw py::value_error("estimator must be 'ols', 'wls' or 'rls', not '" + name + "'");
+}
+
+// The `confidence` keyword, checked.
+double confidence_of(double level) {
+  if (!(level > 0.0 && level < 1.0))
+    throw py::value_error("confidence must be in (0, 1), e.g. 0.999");
+  return level;
+}
+
 IdentifyOptions identify_options(const py::kwargs& kw, nlohmann::json& used) {
   static const char* kKeys[] = {"armature",  "viscous",    "coulomb",   "offset", "asymmetric",
                                 "estimator", "confidence", "cutoff_hz", "filter", "decimate"};
@@ -118,19 +134,9 @@ IdentifyOptions identify_options(const py::kwargs& kw, nlohmann::json& used) {
   IdentifyOptions o;
   o.layout = layout_of(get("armature", true), get("viscous", true), get("coulomb", true),
                        get("offset", true), get("asymmetric", false));
-  const std::string estimator = get("estimator", std::string("ols"));
-  if (estimator == "ols") {
-    o.estimator = IdentificationEstimator::kOls;
-  } else if (estimator == "wls") {
-    o.estimator = IdentificationEstimator::kWls;
-  } else if (estimator == "rls") {
-    o.estimator = IdentificationEstimator::kRls;
-  } else {
-    throw py::value_error("estimator must be 'ols', 'wls' or 'rls', not '" + estimator + "'");
-  }
-  o.confidence_level = get("confidence", 0.999);
-  if (!(o.confidence_level > 0.0 && o.confidence_level < 1.0))
-    throw py::value_error("confidence must be in (0, 1), e.g. 0.999");
+  o.estimator = estimator_of(get("estimator", std::string("ols")), IdentificationEstimator::kOls,
+                             IdentificationEstimator::kWls, IdentificationEstimator::kRls);
+  o.confidence_level = confidence_of(get("confidence", 0.999));
   o.signal.cutoff_hz = get("cutoff_hz", 0.0);
   o.signal.filter = get("filter", true);
   o.signal.decimate = get("decimate", 0);
@@ -180,19 +186,9 @@ nlohmann::json payload(const Model& model, const std::string& sensor_link,
         "load)");
   }
   LoadIdentificationOptions options;
-  const std::string estimator = get("estimator", std::string("ols"));
-  if (estimator == "ols") {
-    options.estimator = LoadEstimator::kOls;
-  } else if (estimator == "wls") {
-    options.estimator = LoadEstimator::kWls;
-  } else if (estimator == "rls") {
-    options.estimator = LoadEstimator::kRls;
-  } else {
-    throw py::value_error("estimator must be 'ols', 'wls' or 'rls', not '" + estimator + "'");
-  }
-  options.confidence_level = get("confidence", 0.999);
-  if (!(options.confidence_level > 0.0 && options.confidence_level < 1.0))
-    throw py::value_error("confidence must be in (0, 1), e.g. 0.999");
+  options.estimator = estimator_of(get("estimator", std::string("ols")), LoadEstimator::kOls,
+                                   LoadEstimator::kWls, LoadEstimator::kRls);
+  options.confidence_level = confidence_of(get("confidence", 0.999));
   SensorMount mount;
   mount.link = find_link(model, sensor_link);
   if (kw.contains("sensor_pose")) {
