@@ -113,18 +113,25 @@ double confidence_of(double level) {
   return level;
 }
 
-IdentifyOptions identify_options(const py::kwargs& kw, nlohmann::json& used) {
-  static const char* kKeys[] = {"armature",  "viscous",    "coulomb",   "offset", "asymmetric",
-                                "estimator", "confidence", "cutoff_hz", "filter", "decimate"};
+// Every keyword is one of `keys`, else a TypeError naming it and the valid ones.
+template <size_t N>
+void check_keywords(const py::kwargs& kw, const char* const (&keys)[N]) {
   std::string valid;
-  for (const char* k : kKeys) valid += (valid.empty() ? "" : ", ") + std::string(k);
+  for (const char* k : keys) valid += (valid.empty() ? "" : ", ") + std::string(k);
   for (const auto& item : kw) {
     const std::string key = py::str(item.first);
-    if (std::find_if(std::begin(kKeys), std::end(kKeys), [&](const char* k) { return key == k; }) ==
-        std::end(kKeys)) {
+    if (std::find_if(std::begin(keys), std::end(keys), [&](const char* k) { return key == k; }) ==
+        std::end(keys)) {
       throw py::type_error("unknown option '" + key + "'; valid options are " + valid);
     }
   }
+}
+
+IdentifyOptions identify_options(const py::kwargs& kw, nlohmann::json& used) {
+  static const char* const kKeys[] = {"armature",   "viscous",   "coulomb",    "offset",
+                                      "asymmetric", "estimator", "confidence", "cutoff_hz",
+                                      "filter",     "decimate"};
+  check_keywords(kw, kKeys);
   auto get = [&](const char* key, auto fallback) {
     using T = decltype(fallback);
     const T value = kw.contains(key) ? kw[key].cast<T>() : fallback;
@@ -149,17 +156,10 @@ nlohmann::json payload(const Model& model, const std::string& sensor_link,
                        const std::optional<Eigen::VectorXd>& t, const Samples& q,
                        const Samples& wrench, const std::optional<RowMatrix>& dq,
                        const std::optional<RowMatrix>& ddq, const py::kwargs& kw) {
-  static const char* kKeys[] = {"sensor_pose", "model",      "interval",  "bias",  "wrench_sign",
-                                "estimator",   "confidence", "cutoff_hz", "filter"};
-  std::string valid;
-  for (const char* k : kKeys) valid += (valid.empty() ? "" : ", ") + std::string(k);
-  for (const auto& item : kw) {
-    const std::string key = py::str(item.first);
-    if (std::find_if(std::begin(kKeys), std::end(kKeys), [&](const char* k) { return key == k; }) ==
-        std::end(kKeys)) {
-      throw py::type_error("unknown option '" + key + "'; valid options are " + valid);
-    }
-  }
+  static const char* const kKeys[] = {"sensor_pose", "model",       "interval",
+                                      "bias",        "wrench_sign", "estimator",
+                                      "confidence",  "cutoff_hz",   "filter"};
+  check_keywords(kw, kKeys);
   auto get = [&](const char* key, auto fallback) {
     using T = decltype(fallback);
     return kw.contains(key) ? kw[key].cast<T>() : fallback;
