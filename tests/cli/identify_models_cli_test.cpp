@@ -346,6 +346,17 @@ TEST(IdentifyModelsCli, FrictionKnownResultIsValidatedWithItsFriction) {
   const double e_without = load(without)["relative_error"].get<double>();
   EXPECT_LT(e_with, 0.5 * e_without) << "with " << e_with << ", without " << e_without;
   EXPECT_LT(e_with, 0.1);
+  // A hand-edited stored friction is one error line, and nothing is written.
+  j["options"]["known_friction"] = "Fvp1=0.3";
+  const std::string edited = (scratch() / "known_edited.json").string();
+  std::ofstream(edited) << j.dump();
+  const std::string none = (scratch() / "validate_edited.json").string();
+  r = run("validate --robot " + robot + " --params " + edited + " --data " + data + " --json " +
+          none);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(testing::error_contract_problem(r.err), "");
+  EXPECT_NE(r.err.find("options.known_friction"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(none));
 }
 
 }  // namespace
