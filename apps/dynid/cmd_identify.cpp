@@ -576,7 +576,12 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   RepeatedEstimate repeated;
   std::vector<JointRecord> records;
   if (o.stream) {
+    // Reading the big file is the whole wait: the line counts its bytes.
+    ProgressLine progress("identify", progress_wanted(o.quiet));
+    options.progress = progress.callback();
     result = identify_stream(model, o.data, file, options, {o.threads, true});
+    progress.finish();
+    options.progress = nullptr;  // it refers to this scope's line
   } else {
     // Each run read on its own (same column mapping, window and torque scale for every run).
     // Reading a big file is most of the wait; the stages after it report as one step.

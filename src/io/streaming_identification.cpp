@@ -5,6 +5,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <exception>
+#include <filesystem>
 #include <mutex>
 #include <random>
 #include <thread>
@@ -131,10 +132,23 @@ void process_block(const StreamSetup& s, Worker& w, const Eigen::MatrixXd& block
 // reader thread only cuts lines; each worker parses its own chunks, so the parse runs on every
 // core instead of bounding the rate from one thread.
 // Returns the merged accumulator. The first error in file order is rethrown after all threads
-// have stopped, so no thread outlives the call.
+// have stopped, so no thread outlives the call. `progress` (may be empty) is told the fraction of
+// the file's bytes cut so far, from this (the calling) thread only, so that a caller's progress
+// line needs no lock.
 StreamingLeastSquares accumulate(const StreamSetup& s, const StreamingOptions& lsq_options,
-                                 int threads, Eigen::Index& samples) {
+                                 int threads, Eigen::Index& samples,
+                                 const ProgressCallback& progress, const std::string& what) {
   const int rank = s.base->rank;
+  // Bytes of the data lines cut so far (text plus one terminator each; the header and comments
+  // are not counted, so the fraction ends a little below 1) over the file size.
+  std::error_code size_error;
+  const auto file_bytes = std::filesystem::file_size(s.path, size_error);
+  double cut_bytes = 0.0;
+  const auto tell = [&](const CsvTextChunk& chunk) {
+    if (!progress || size_error || file_bytes == 0) return;
+    cut_bytes += static_cast<double>(chunk.text.size() + chunk.ends.size());
+    progress(std::min(1.0, cut_bytes / static_cast<double>(file_bytes)), what);
+  };
   std::vector<std::unique_ptr<Worker>> workers;
   for (int t = 0; t < threads; ++t) {
     workers.push_back(std::make_unique<Worker>(*s.model, *s.layout, rank, lsq_options));
@@ -144,6 +158,7 @@ StreamingLeastSquares accumulate(const StreamSetup& s, const StreamingOptions& l
   if (threads == 1) {
     Worker& w = *workers[0];
     while (reader.next_text(w.chunks[0])) {
+      tell(w.chunks[0]);
       reader.parse_text(w.chunks[0], w.block);
       process_block(s, w, w.block, samples);
       samples += w.block.rows();
@@ -184,6 +199,7 @@ StreamingLeastSquares accumulate(const StreamSetup& s, const StreamingOptions& l
   try {
     CsvTextChunk chunk;
     while (reader.next_text(chunk)) {
+      tell(chunk);
       Worker& w = *workers[index % threads];
       std::unique_lock<std::mutex> lock(w.mutex);
       w.cv.wait(lock, [&w] { return w.tail - w.head < kQueueDepth; });
@@ -342,7 +358,8 @@ IdentificationResult identify_stream(const Model& model, const std::string& path
                                                               : lsq.solve_ordinary(eo);
   };
   Eigen::Index samples = 0;
-  StreamingLeastSquares lsq = accumulate(s, lsq_options, threads, samples);
+  StreamingLeastSquares lsq =
+      accumulate(s, lsq_options, threads, samples, options.progress, "reading " + path);
   std::string accumulation = stream.normal_equations
                                  ? "normal equations (column-equilibrated condition of [W y] "
                                    "within 1e5)"
@@ -351,7 +368,8 @@ IdentificationResult identify_stream(const Model& model, const std::string& path
     result.estimate = solve(lsq);
   } catch (const NormalEquationsError& e) {
     lsq_options.accumulation = Accumulation::kHouseholder;
-    lsq = accumulate(s, lsq_options, threads, samples);
+    lsq = accumulate(s, lsq_options, threads, samples, options.progress,
+                     "second pass (Householder QR) over " + path);
     result.estimate = solve(lsq);
     accumulation = std::string("Householder QR, second pass: ") + e.what();
   }

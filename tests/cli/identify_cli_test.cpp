@@ -379,3 +379,32 @@ TEST(IdentifyCli, RlsHistoryIsWrittenAndNeedsRls) {
   EXPECT_EQ(bad.code, 2);
   EXPECT_NE(bad.err.find("error: --history needs --estimator rls"), std::string::npos) << bad.err;
 }
+
+// identify --stream draws a progress line when stderr is a terminal (a pseudo-terminal from
+// util-linux's script), not with --quiet, and not into a file.
+TEST(IdentifyCli, StreamShowsProgressOnATerminalOnly) {
+  if (std::system("command -v script >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "util-linux script (a pseudo-terminal) is not installed";
+  }
+  const std::string data = planar2_run();
+  const std::string out = ::testing::TempDir() + "/planar2_stream_progress.json";
+  const std::string args = "identify --robot planar2 --stream --data " + data +
+                           " --friction none --no-armature --filter none --out " + out;
+  const std::string line = "% reading " + data;
+  const auto on_terminal = [&](const std::string& extra) {
+    const std::string capture =
+        ::testing::TempDir() + "/stream_tty." + std::to_string(::getpid()) + ".txt";
+    const std::string cmd = "script -qec '" + std::string(DYNID_BINARY) + " " + args + extra +
+                            "' /dev/null </dev/null >" + capture;
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    std::ifstream f(capture);
+    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  };
+  const std::string shown = on_terminal("");
+  EXPECT_NE(shown.find("\ridentify: 9"), std::string::npos) << shown;  // one chunk: 9x %
+  EXPECT_NE(shown.find(line), std::string::npos) << shown;
+  EXPECT_EQ(on_terminal(" --quiet").find(line), std::string::npos);
+  const CliRun file = run(args);
+  ASSERT_EQ(file.code, 0) << file.err;
+  EXPECT_EQ(file.err.find(line), std::string::npos) << file.err;
+}

@@ -1,6 +1,8 @@
+#include <algorithm>
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -171,6 +173,42 @@ TEST(StreamingIdentification, RefusesFilteringAndMissingDerivatives) {
   RunFileOptions rename;
   rename.columns = {{"dq1", "v1"}};
   EXPECT_THROW(identify_stream(model, path, rename, o), Error);
+}
+
+// Progress: one call per chunk of the file, from the calling thread (the CLI's progress line is
+// not locked), fractions of the bytes read that never decrease and end near 1 (only the header
+// is not counted); a second, Householder pass says so.
+TEST(StreamingIdentification, ProgressCountsTheBytesReadOnTheCallingThread) {
+  const Model model = load_robot("puma560");
+  const std::string path = write_run(model, 10000, 0.3, "stream_progress.csv");  // 3 chunks
+  IdentifyOptions o;
+  o.signal.filter = false;
+  for (int threads : {1, 3}) {
+    std::vector<double> fractions;
+    bool same_thread = true, named = true;
+    const auto caller = std::this_thread::get_id();
+    o.progress = [&](double fraction, const std::string& what) {
+      fractions.push_back(fraction);
+      same_thread = same_thread && std::this_thread::get_id() == caller;
+      named = named && what == "reading " + path;
+    };
+    identify_stream(model, path, {}, o, {threads, true});
+    ASSERT_EQ(fractions.size(), 3u) << threads;
+    EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
+    EXPECT_GT(fractions.front(), 0.3);
+    EXPECT_LT(fractions.front(), 0.5);  // 4096 of 10000 rows of equal length
+    EXPECT_GT(fractions.back(), 0.99);
+    EXPECT_LE(fractions.back(), 1.0);
+    EXPECT_TRUE(same_thread);
+    EXPECT_TRUE(named);
+  }
+  const std::string exact = write_run(model, 3000, 0.0, "stream_progress_exact.csv");
+  std::vector<std::string> what;
+  o.progress = [&](double, const std::string& w) { what.push_back(w); };
+  identify_stream(model, exact, {}, o, {2, true});
+  ASSERT_EQ(what.size(), 2u);  // one chunk, read twice
+  EXPECT_EQ(what[0], "reading " + exact);
+  EXPECT_EQ(what[1], "second pass (Householder QR) over " + exact);
 }
 
 }  // namespace

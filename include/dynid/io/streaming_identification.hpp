@@ -30,6 +30,8 @@ struct StreamingIdentificationOptions {
 /// Rows with |dq_j| below options.signal.zero_velocity are dropped when given (no automatic
 /// threshold: it would need a second pass). Estimators: OLS or WLS (Gautier, per-joint variance
 /// from the per-joint factors). Same result as identify() on the same rows, up to round-off.
+/// options.progress (may be empty) is told the fraction of the file's bytes read, per chunk, from
+/// the calling thread (a second, Householder pass starts again from 0 and says so).
 /// Throws dynid::Error naming the file row for NaN/Inf samples and malformed lines.
 IdentificationResult identify_stream(const Model& model, const std::string& path,
                                      const RunFileOptions& file, const IdentifyOptions& options,
