@@ -179,6 +179,11 @@ IdentifiedResultFile read_identification_result(const std::string& path) {
   } catch (const std::exception& ex) {
     throw Error("'" + path + "' is not valid JSON (" + one_line(ex.what()) + ")");
   }
+  return identification_result_from_json(j, path);
+}
+
+IdentifiedResultFile identification_result_from_json(const nlohmann::json& j,
+                                                     const std::string& path) {
   if (!j.is_object() || !j.contains("parameters") || !j["parameters"].is_array()) {
     throw Error("'" + path + "' has no 'parameters' list; give the result.json of dynid identify");
   }

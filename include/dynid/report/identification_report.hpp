@@ -45,6 +45,11 @@ struct IdentifiedResultFile {
 /// `parameters` is missing or malformed, or a stored threshold is not a non-negative number.
 IdentifiedResultFile read_identification_result(const std::string& path);
 
+/// read_identification_result of a parsed result (the Python module's dicts); `path` names it in
+/// the messages.
+IdentifiedResultFile identification_result_from_json(const nlohmann::json& j,
+                                                     const std::string& path);
+
 /// Reads `parameters[].name/value` and `options` of a result JSON (read_identification_result).
 void read_identified_parameters(const std::string& path, std::vector<std::string>& names,
                                 Eigen::VectorXd& values, nlohmann::json& options_used);
