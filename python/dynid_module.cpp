@@ -7,7 +7,10 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
+#include <sstream>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -150,68 +153,133 @@ IdentifyOptions identify_options(const py::kwargs& kw, nlohmann::json& used) {
   return o;
 }
 
-// payload() of a wrist force/torque sensor on the robot, as `dynid payload --robot R
-// --sensor-link L`: the same stages and the same JSON (payload_to_json).
-nlohmann::json payload(const Model& model, const std::string& sensor_link,
-                       const std::optional<Eigen::VectorXd>& t, const Samples& q,
-                       const Samples& wrench, const std::optional<RowMatrix>& dq,
-                       const std::optional<RowMatrix>& ddq, const py::kwargs& kw) {
-  static const char* const kKeys[] = {"sensor_pose", "model",       "interval",
-                                      "bias",        "wrench_sign", "estimator",
-                                      "confidence",  "cutoff_hz",   "filter"};
-  check_keywords(kw, kKeys);
-  auto get = [&](const char* key, auto fallback) {
-    using T = decltype(fallback);
-    return kw.contains(key) ? kw[key].cast<T>() : fallback;
-  };
+// The load equations and estimator shared by the sensor modes of payload (`dynid payload`'s
+// --model, --static, --interval, --bias, --wrench-sign, --estimator, --confidence).
+struct LoadKeywords {
   LoadEquationOptions equations;
-  const std::string kind = get("model", std::string("differential"));
-  if (kind == "differential") {
-    equations.model = LoadModelKind::kDifferential;
-  } else if (kind == "integral") {
-    equations.model = LoadModelKind::kIntegral;
-  } else if (kind == "static") {
-    equations.model = LoadModelKind::kStatic;
+  LoadIdentificationOptions options;
+  std::string model;  // the JSON's `model`
+};
+
+template <class Get>
+LoadKeywords load_keywords(const Get& get) {
+  LoadKeywords k;
+  k.model = get("equations", std::string("differential"));
+  if (k.model == "differential") {
+    k.equations.model = LoadModelKind::kDifferential;
+  } else if (k.model == "integral") {
+    k.equations.model = LoadModelKind::kIntegral;
+  } else if (k.model == "static") {
+    k.equations.model = LoadModelKind::kStatic;
   } else {
-    throw py::value_error("model must be 'differential', 'integral' or 'static', not '" + kind +
-                          "'");
+    throw py::value_error("equations must be 'differential', 'integral' or 'static', not '" +
+                          k.model + "'");
   }
-  equations.interval = get("interval", 0.2);
-  if (!(equations.interval > 0.0)) throw py::value_error("interval must be a positive window [s]");
-  equations.bias = get("bias", false);
-  equations.wrench_sign = get("wrench_sign", 1.0);
-  if (!(equations.wrench_sign == 1.0 || equations.wrench_sign == -1.0)) {
+  k.equations.interval = get("interval", 0.2);
+  if (!(k.equations.interval > 0.0))
+    throw py::value_error("interval must be a positive window [s]");
+  k.equations.bias = get("bias", false);
+  k.equations.wrench_sign = get("wrench_sign", 1.0);
+  if (!(k.equations.wrench_sign == 1.0 || k.equations.wrench_sign == -1.0)) {
     throw py::value_error(
         "wrench_sign must be 1 (force of the load on the sensor) or -1 (of the sensor on the "
         "load)");
   }
-  LoadIdentificationOptions options;
-  options.estimator = estimator_of(get("estimator", std::string("ols")), LoadEstimator::kOls,
-                                   LoadEstimator::kWls, LoadEstimator::kRls);
-  options.confidence_level = confidence_of(get("confidence", 0.999));
-  SensorMount mount;
-  mount.link = find_link(model, sensor_link);
-  if (kw.contains("sensor_pose")) {
-    const auto pose = kw["sensor_pose"].cast<std::vector<double>>();
-    if (pose.size() != 6) {
-      throw py::value_error("sensor_pose must be [x, y, z, roll, pitch, yaw] [m, rad]");
-    }
-    mount.p_LS = Eigen::Vector3d(pose[0], pose[1], pose[2]);
-    mount.R_LS = roll_pitch_yaw(pose[3], pose[4], pose[5]);
+  k.options.estimator = estimator_of(get("estimator", std::string("ols")), LoadEstimator::kOls,
+                                     LoadEstimator::kWls, LoadEstimator::kRls);
+  k.options.confidence_level = confidence_of(get("confidence", 0.999));
+  return k;
+}
+
+// A keyword's value or `fallback` (of the keyword's type).
+auto keyword_getter(const py::kwargs& kw) {
+  return [&kw](const char* key, auto fallback) {
+    using T = decltype(fallback);
+    return kw.contains(key) ? kw[key].cast<T>() : fallback;
+  };
+}
+
+// A pose keyword [x, y, z, roll, pitch, yaw] [m, rad] as (R, p), URDF roll-pitch-yaw.
+std::pair<Eigen::Matrix3d, Eigen::Vector3d> pose_of(const py::kwargs& kw, const char* key,
+                                                    const char* of) {
+  const auto pose = kw[key].cast<std::vector<double>>();
+  if (pose.size() != 6 ||
+      !std::all_of(pose.begin(), pose.end(), [](double x) { return std::isfinite(x); })) {
+    throw py::value_error(std::string(key) + " must be [x, y, z, roll, pitch, yaw] of " + of +
+                          " [m, rad], finite");
   }
-  const bool standing = equations.model == LoadModelKind::kStatic;
-  if (!standing && !t) throw py::value_error("t is required unless model='static'");
-  const RowMatrix::Index rows = q.rows();
-  if (t && t->size() != rows) {
-    throw Error("t has " + std::to_string(t->size()) + " samples, q " + std::to_string(rows));
-  }
-  check_samples(model, "q", rows, q);
+  return {roll_pitch_yaw(pose[3], pose[4], pose[5]), Eigen::Vector3d(pose[0], pose[1], pose[2])};
+}
+
+void check_wrench(RowMatrix::Index rows, const Samples& wrench) {
   if (wrench.rows() != rows || wrench.cols() != 6) {
     throw Error("wrench must be " + std::to_string(rows) +
                 " x 6 (fx fy fz mx my mz [N, N m] in the sensor frame), not " +
                 std::to_string(wrench.rows()) + " x " + std::to_string(wrench.cols()));
   }
   if (!wrench.allFinite()) throw Error("wrench holds NaN or Inf");
+}
+
+// An optional m×k block of the sensor log (w, dw, a), checked; empty when absent.
+Eigen::MatrixXd log_columns(const std::optional<RowMatrix>& x, const char* name,
+                            RowMatrix::Index rows, RowMatrix::Index cols) {
+  if (!x) return {};
+  if (x->rows() != rows || x->cols() != cols) {
+    throw Error(std::string(name) + " must be " + std::to_string(rows) + " x " +
+                std::to_string(cols) + ", not " + std::to_string(x->rows()) + " x " +
+                std::to_string(x->cols()));
+  }
+  if (!x->allFinite()) throw Error(std::string(name) + " holds NaN or Inf");
+  return *x;
+}
+
+// The load's equations, estimate and JSON, as `dynid payload` ends every sensor mode.
+nlohmann::json solve_load(const SensorMotion& motion, const Eigen::MatrixXd& wrench,
+                          const LoadKeywords& k, const nlohmann::json& frame,
+                          const std::vector<std::pair<std::string, std::string>>& choices) {
+  const EquationBlock block = load_equations(motion, wrench, k.equations);
+  LoadIdentificationResult r;
+  {
+    py::gil_scoped_release release;
+    r = identify_load(block, k.options);
+  }
+  PayloadJsonContext context;
+  context.model = k.model;
+  context.frame = frame;
+  context.extra = {{"wrench_sign", k.equations.wrench_sign}};
+  if (k.equations.model == LoadModelKind::kIntegral)
+    context.extra["interval"] = k.equations.interval;
+  context.group_names = block.group_names;
+  context.with_inertia = k.equations.model != LoadModelKind::kStatic;
+  context.choices = choices;
+  return payload_to_json(r, context);
+}
+
+// payload() of a wrist force/torque sensor on the robot, as `dynid payload --robot R
+// --sensor-link L`: the same stages and the same JSON (payload_to_json).
+nlohmann::json payload(const Model& model, const std::string& sensor_link,
+                       const std::optional<Eigen::VectorXd>& t, const Samples& q,
+                       const Samples& wrench, const std::optional<RowMatrix>& dq,
+                       const std::optional<RowMatrix>& ddq, const py::kwargs& kw) {
+  static const char* const kKeys[] = {"sensor_pose", "equations",   "interval",
+                                      "bias",        "wrench_sign", "estimator",
+                                      "confidence",  "cutoff_hz",   "filter"};
+  check_keywords(kw, kKeys);
+  const auto get = keyword_getter(kw);
+  LoadKeywords k = load_keywords(get);
+  SensorMount mount;
+  mount.link = find_link(model, sensor_link);
+  if (kw.contains("sensor_pose")) {
+    std::tie(mount.R_LS, mount.p_LS) = pose_of(kw, "sensor_pose", "the sensor in the link frame");
+  }
+  const bool standing = k.equations.model == LoadModelKind::kStatic;
+  if (!standing && !t) throw py::value_error("t is required unless equations='static'");
+  const RowMatrix::Index rows = q.rows();
+  if (t && t->size() != rows) {
+    throw Error("t has " + std::to_string(t->size()) + " samples, q " + std::to_string(rows));
+  }
+  check_samples(model, "q", rows, q);
+  check_wrench(rows, wrench);
   JointRecord record;
   if (t) record.t = *t;
   record.q = q;
@@ -236,23 +304,222 @@ nlohmann::json payload(const Model& model, const std::string& sensor_link,
     signal.cutoff_hz = get("cutoff_hz", 0.0);
     PreparedLoadRun run = prepare_load_run(record, w, signal, choices);
     // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
-    options.hac_covariance = signal.filter;
+    k.options.hac_covariance = signal.filter;
     w = std::move(run.wrench);
     motion = sensor_motion_from_joints(model, run.record, mount);
   }
-  const EquationBlock block = load_equations(motion, w, equations);
+  return solve_load(motion, w, k,
+                    {{"robot", model.name}, {"sensor_link", model.joints[mount.link].link_name}},
+                    choices);
+}
+
+// payload_from_orientation(): a sensor without a robot model, as `dynid payload` with the columns
+// qx qy qz qw [wx wy wz dwx dwy dwz ax ay az].
+nlohmann::json payload_from_orientation(const std::optional<Eigen::VectorXd>& t,
+                                        const Samples& quaternion, const Samples& wrench,
+                                        const std::optional<RowMatrix>& w,
+                                        const std::optional<RowMatrix>& dw,
+                                        const std::optional<RowMatrix>& a, const py::kwargs& kw) {
+  static const char* const kKeys[] = {"equations", "interval",   "bias",   "wrench_sign",
+                                      "estimator", "confidence", "gravity"};
+  check_keywords(kw, kKeys);
+  const auto get = keyword_getter(kw);
+  const LoadKeywords k = load_keywords(get);
+  const auto g = get("gravity", std::vector<double>{0.0, 0.0, -9.81});
+  if (g.size() != 3)
+    throw py::value_error("gravity must be [gx, gy, gz] in the base frame [m/s^2]");
+  const bool standing = k.equations.model == LoadModelKind::kStatic;
+  if (!standing && !t) throw py::value_error("t is required unless equations='static'");
+  const RowMatrix::Index rows = quaternion.rows();
+  if (quaternion.cols() != 4) {
+    throw Error("quaternion must be " + std::to_string(rows) +
+                " x 4 (qx qy qz qw: the sensor frame in the base frame), not " +
+                std::to_string(rows) + " x " + std::to_string(quaternion.cols()));
+  }
+  if (!quaternion.allFinite()) throw Error("quaternion holds NaN or Inf");
+  check_wrench(rows, wrench);
+  OrientationLog log;
+  log.quaternion = quaternion;
+  if (!standing) {  // standing poses: only the orientation is used, as on the command line
+    if (t->size() != rows) {
+      throw Error("t has " + std::to_string(t->size()) + " samples, quaternion " +
+                  std::to_string(rows));
+    }
+    log.t = *t;
+    log.w = log_columns(w, "w", rows, 3);
+    log.dw = log_columns(dw, "dw", rows, 3);
+    log.a = log_columns(a, "a", rows, 3);
+  }
+  std::vector<std::pair<std::string, std::string>> choices;
+  const SensorMotion motion =
+      sensor_motion_from_orientation(log, Eigen::Vector3d(g[0], g[1], g[2]), choices);
+  return solve_load(motion, wrench, k, {{"orientation", "qx qy qz qw from the data"}}, choices);
+}
+
+// The identify options that rebuild a reference result's regressor and filtering (`dynid
+// payload --reference result.json`, as `dynid validate` reads the file): friction set and
+// armature from its `options` (a dynid.identify dict or the command line's result.json), the
+// cut-off and zero-velocity thresholds identify used.
+IdentifyOptions options_of_result(const IdentifiedResultFile& identified) {
+  const nlohmann::json& o = identified.options;
+  const auto flag = [&](const char* key, bool fallback) {
+    return o.contains(key) && o[key].is_boolean() ? o[key].get<bool>() : fallback;
+  };
+  IdentifyOptions options;
+  if (o.contains("friction") && o["friction"].is_string()) {  // the command line's --friction
+    const std::string friction = o["friction"].get<std::string>();
+    const auto has = [&](const char* term) { return friction.find(term) != std::string::npos; };
+    const bool asymmetric = has("asymmetric");
+    options.layout = layout_of(flag("armature", true), has("viscous"), has("coulomb"),
+                               has("offset"), asymmetric);
+  } else {
+    options.layout = layout_of(flag("armature", true), flag("viscous", true), flag("coulomb", true),
+                               flag("offset", true), flag("asymmetric", false));
+  }
+  if (o.contains("filter") && o["filter"].is_string()) {  // the command line's --filter
+    const std::string filter = o["filter"].get<std::string>();
+    if (filter != "auto" && filter != "none") {
+      throw Error("the reference result was filtered with --filter " + filter +
+                  ", which only the command line rebuilds; use dynid payload --reference "
+                  "result.json");
+    }
+    options.signal.filter = filter == "auto";
+  } else {
+    options.signal.filter = flag("filter", true);
+  }
+  for (const char* key : {"savitzky_golay", "filter_coulomb_columns"}) {
+    if (flag(key, false)) {
+      throw Error(std::string("the reference result was identified with ") + key +
+                  ", which only the command line rebuilds; use dynid payload --reference "
+                  "result.json");
+    }
+  }
+  options.signal.cutoff_hz =
+      identified.cutoff_hz > 0.0
+          ? identified.cutoff_hz
+          : (o.contains("cutoff_hz") && o["cutoff_hz"].is_number() ? o["cutoff_hz"].get<double>()
+                                                                   : 0.0);
+  if (!identified.zero_velocity_threshold.empty()) {
+    options.signal.zero_velocity = identified.zero_velocity_threshold;
+  } else if (o.contains("zero_velocity") && o["zero_velocity"].is_array()) {
+    options.signal.zero_velocity = o["zero_velocity"].get<std::vector<double>>();
+  }
+  if (o.contains("torque_offset_s") && o["torque_offset_s"].is_number())
+    options.signal.torque_time_offset = o["torque_offset_s"].get<double>();
+  return options;
+}
+
+// payload_from_torques(): a load without a sensor, as `dynid payload --robot R --link L
+// --reference unloaded.csv|result.json`.
+nlohmann::json payload_from_torques(const Model& model, const std::string& link_name,
+                                    const Eigen::VectorXd& t, const Samples& q, const Samples& tau,
+                                    const py::dict& reference, const std::optional<RowMatrix>& dq,
+                                    const std::optional<RowMatrix>& ddq, const py::kwargs& kw) {
+  static const char* const kKeys[] = {"frame", "estimator", "confidence", "cutoff_hz", "filter"};
+  check_keywords(kw, kKeys);
+  const auto get = keyword_getter(kw);
+  LoadIdentificationOptions options;
+  options.estimator = estimator_of(get("estimator", std::string("ols")), LoadEstimator::kOls,
+                                   LoadEstimator::kWls, LoadEstimator::kRls);
+  options.confidence_level = confidence_of(get("confidence", 0.999));
+  LoadFrame frame;
+  std::string frame_text = "link frame";
+  if (kw.contains("frame")) {
+    std::tie(frame.R_LF, frame.p_LF) = pose_of(kw, "frame", "the load's frame in the link frame");
+    std::ostringstream text;
+    const auto pose = kw["frame"].cast<std::vector<double>>();
+    for (size_t i = 0; i < pose.size(); ++i) text << (i ? " " : "") << pose[i];
+    frame_text = text.str();
+  }
+  const int link = find_link(model, link_name);
+  const JointRecord loaded_raw = record_of(model, t, q, tau, dq, ddq);
   LoadIdentificationResult r;
-  {
+  std::vector<std::pair<std::string, std::string>> choices;
+  std::string reference_text;
+  if (reference.contains("parameters")) {  // an identify() result of the unloaded robot
+    if (kw.contains("cutoff_hz") || kw.contains("filter")) {
+      throw py::value_error(
+          "cutoff_hz and filter come from the reference result (the loaded run is filtered as "
+          "identify filtered the unloaded one); drop them");
+    }
+    const nlohmann::json j = nlohmann::json::parse(
+        py::module_::import("json").attr("dumps")(reference).cast<std::string>());
+    const IdentifiedResultFile identified = identification_result_from_json(j, "reference");
+    if (!identified.robot.empty() && identified.robot != model.name) {
+      throw Error("the reference result is of robot '" + identified.robot + "', not '" +
+                  model.name + "'; give a result of the robot that carries the load");
+    }
+    const IdentifyOptions identify = options_of_result(identified);
+    // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
+    options.hac_covariance = identify.signal.filter;
+    {
+      py::gil_scoped_release release;
+      const ValidationResult predicted = validate_torques(
+          model, loaded_raw, identified.names, identified.values, identify, identified.not_excited);
+      r = identify_load_from_unexplained_torques(model, link, frame, predicted.processed.record,
+                                                 predicted.predicted,
+                                                 predicted.zero_velocity_threshold, options);
+      choices = predicted.choices;
+    }
+    if (identified.options.contains("torque_scale") &&
+        !identified.options["torque_scale"].empty()) {
+      choices.emplace_back("torque_scale",
+                           "the reference's torque scale is not applied: tau is taken as the "
+                           "joint torques [N m]");
+    }
+    choices.emplace_back("reference_model",
+                         "the torque of the reference identify result predicted on this run as "
+                         "validate does; rows below its zero-velocity thresholds are left out of "
+                         "the load fit too; its own uncertainty is not propagated");
+    reference_text = "identify result (dict)";
+  } else {  // the unloaded run's arrays: robot and load identified together
+    static const char* const kRunKeys[] = {"t", "q", "tau", "dq", "ddq"};
+    for (const auto& item : reference) {
+      const std::string key = py::str(item.first);
+      if (std::find(std::begin(kRunKeys), std::end(kRunKeys), key) == std::end(kRunKeys)) {
+        throw py::value_error("reference: unknown key '" + key +
+                              "'; give an identify() result (with 'parameters') or the unloaded "
+                              "run {'t', 'q', 'tau'[, 'dq', 'ddq']}");
+      }
+    }
+    for (const char* key : {"t", "q", "tau"}) {
+      if (!reference.contains(key)) {
+        throw py::value_error(std::string("reference has no '") + key +
+                              "'; give an identify() result (with 'parameters') or the unloaded "
+                              "run {'t', 'q', 'tau'[, 'dq', 'ddq']}");
+      }
+    }
+    const auto optional_of = [&](const char* key) {
+      return reference.contains(key) ? std::optional<RowMatrix>(reference[key].cast<RowMatrix>())
+                                     : std::optional<RowMatrix>();
+    };
+    const JointRecord unloaded_raw =
+        record_of(model, reference["t"].cast<Eigen::VectorXd>(), reference["q"].cast<RowMatrix>(),
+                  reference["tau"].cast<RowMatrix>(), optional_of("dq"), optional_of("ddq"));
+    SignalOptions signal;
+    signal.filter = get("filter", true);
+    signal.cutoff_hz = get("cutoff_hz", 0.0);
+    options.hac_covariance = signal.filter;
+    std::vector<std::pair<std::string, std::string>> reference_choices;
+    const JointRecord loaded = preprocess(loaded_raw, signal, choices).record;
+    const JointRecord unloaded = preprocess(unloaded_raw, signal, reference_choices).record;
     py::gil_scoped_release release;
-    r = identify_load(block, options);
+    r = identify_load_from_torques(model, link, frame, ParameterLayout::full(), loaded, unloaded,
+                                   options);
+    reference_text = "unloaded run (arrays)";
+  }
+  std::vector<std::string> joints, determined;
+  for (const auto& joint : model.joints) joints.push_back(joint.name);
+  for (const auto& name : r.names) {
+    if (std::find(r.not_excited.begin(), r.not_excited.end(), name) == r.not_excited.end())
+      determined.push_back(name);
   }
   PayloadJsonContext context;
-  context.model = kind;
-  context.frame = {{"robot", model.name}, {"sensor_link", model.joints[mount.link].link_name}};
-  context.extra = {{"wrench_sign", equations.wrench_sign}};
-  if (equations.model == LoadModelKind::kIntegral) context.extra["interval"] = equations.interval;
-  context.group_names = block.group_names;
-  context.with_inertia = !standing;
+  context.model = "joint_torques";
+  context.frame = {
+      {"robot", model.name}, {"link", model.joints[link].link_name}, {"frame", frame_text}};
+  context.extra = {{"reference", reference_text}, {"determined_by_torques", determined}};
+  context.group_names = joints;
   context.choices = choices;
   return payload_to_json(r, context);
 }
@@ -407,16 +674,66 @@ PYBIND11_MODULE(dynid, m) {
       },
       py::arg("model"), py::arg("sensor_link"), py::arg("t"), py::arg("q"), py::arg("wrench"),
       py::arg("dq") = py::none(), py::arg("ddq") = py::none(),
-      "Inertial parameters of a gripped load from a wrist force/torque sensor, as 'dynid payload "
-      "--robot R --sensor-link L' (Dutkiewicz, Kozlowski, Wroblewski 1993): sensor_link names "
-      "the link (or joint) that carries the sensor; t (m,) [s] (None with model='static'), q "
-      "(m x n), wrench (m x 6: fx fy fz mx my mz [N, N m], the force of the load on the sensor, "
-      "sensor frame), optional dq, ddq. Options: sensor_pose [x, y, z, roll, pitch, yaw] of the "
-      "sensor in the link frame [m, rad], model ('differential', 'integral', 'static'), interval "
-      "(integral window [s], 0.2), bias (bool: sensor offsets), wrench_sign (1 or -1), estimator "
-      "('ols', 'wls', 'rls'), confidence (0.999), cutoff_hz (0 = automatic), filter (bool). "
-      "Returns a dict with the keys of the payload JSON (parameters, mass, com, inertia_com, "
-      "physically_consistent, ...).");
+      "Inertial parameters of a gripped load (m mcx mcy mcz Ixx Ixy Ixz Iyy Iyz Izz about the "
+      "sensor origin, sensor axes) from a wrist force/torque sensor on a robot, as 'dynid "
+      "payload --robot R --sensor-link L' (P. Dutkiewicz, K. R. Kozlowski, W. S. Wroblewski, "
+      "'Experimental Identification of Robot and Load Dynamic Parameters', 1993, section III): "
+      "sensor_link names the link (or joint) that carries the sensor; t (m,) [s] (None with "
+      "equations='static'), q (m x n), wrench (m x 6: fx fy fz mx my mz [N, N m], the force of the "
+      "load on the sensor, sensor frame), optional dq, ddq. Options: sensor_pose [x, y, z, roll, "
+      "pitch, yaw] of the sensor in the link frame [m, rad] (--sensor-pose), equations "
+      "('differential', 'integral' or 'static': --model, or --static: rows are standing poses, "
+      "only m and mc; not 'model', which names the robot), interval (integral window [s], 0.2), "
+      "bias (bool: the six sensor offsets, --bias), "
+      "wrench_sign (1 or -1), estimator ('ols', 'wls', 'rls'), confidence (0.999), cutoff_hz (0 "
+      "= automatic), filter (bool). Returns a dict with the keys of the payload JSON "
+      "(parameters, mass, com, inertia_com, physically_consistent, not_excited, ...). Other "
+      "modes: payload_from_orientation (no robot model), payload_from_torques (no sensor).");
+
+  m.def(
+      "payload_from_orientation",
+      [](const std::optional<Eigen::VectorXd>& t, const Samples& quaternion, const Samples& wrench,
+         const std::optional<RowMatrix>& w, const std::optional<RowMatrix>& dw,
+         const std::optional<RowMatrix>& a, const py::kwargs& kw) {
+        return to_python(payload_from_orientation(t, quaternion, wrench, w, dw, a, kw));
+      },
+      py::arg("t"), py::arg("quaternion"), py::arg("wrench"), py::arg("w") = py::none(),
+      py::arg("dw") = py::none(), py::arg("a") = py::none(),
+      "Inertial parameters of a gripped load from a force/torque sensor whose own orientation is "
+      "logged (no robot model), as 'dynid payload' with the columns qx qy qz qw [wx wy wz dwx dwy "
+      "dwz ax ay az]: t (m,) [s] (None with equations='static'); quaternion (m x 4: qx qy qz qw, "
+      "unit, "
+      "the sensor frame in the base frame); wrench (m x 6: fx fy fz mx my mz [N, N m], the force "
+      "of the load on the sensor, sensor frame); optional w (m x 3, angular velocity [rad/s]), dw "
+      "(m x 3 [rad/s^2]) and a (m x 3, linear acceleration of the sensor origin [m/s^2], gravity "
+      "not included), all in the sensor frame. Missing w and dw are central differences of the "
+      "quaternion and of w; a missing a is taken as zero (the sensor turns about its origin; "
+      "'choices' says so). Options: gravity [gx, gy, gz] in the base frame ([0, 0, -9.81]), "
+      "equations ('differential', 'integral', 'static'), interval, bias, wrench_sign, estimator, "
+      "confidence, as for payload(). Returns a dict with the keys of the payload JSON.");
+
+  m.def(
+      "payload_from_torques",
+      [](const Model& model, const std::string& link, const Eigen::VectorXd& t, const Samples& q,
+         const Samples& tau, const py::dict& reference, const std::optional<RowMatrix>& dq,
+         const std::optional<RowMatrix>& ddq, const py::kwargs& kw) {
+        return to_python(payload_from_torques(model, link, t, q, tau, reference, dq, ddq, kw));
+      },
+      py::arg("model"), py::arg("link"), py::arg("t"), py::arg("q"), py::arg("tau"),
+      py::arg("reference"), py::arg("dq") = py::none(), py::arg("ddq") = py::none(),
+      "Inertial parameters of a load on link `link` (link or joint name) from joint torques, "
+      "without a sensor, as 'dynid payload --robot R --link L --reference ...': t (m,) [s], q "
+      "and tau (m x n) of a run with the load gripped, optional dq, ddq. reference: either the "
+      "unloaded robot's run as a dict {'t', 'q', 'tau'[, 'dq', 'ddq']} (robot and load "
+      "identified together; --reference unloaded.csv), or an identify() result of the unloaded "
+      "robot (a dynid.identify dict or the command line's result.json loaded with json.load; "
+      "--reference result.json): the loaded run is then filtered and predicted as validate does "
+      "with that result (its friction set, cut-off and zero-velocity thresholds) and the load is "
+      "fitted to the torque the model does not explain. Options: frame [x, y, z, roll, pitch, "
+      "yaw] of the frame the load is reported in, in the link frame [m, rad] (default the link "
+      "frame; --frame), estimator ('ols', 'wls'), confidence (0.999), and with a reference run "
+      "cutoff_hz (0 = automatic) and filter (bool). Returns a dict with the keys of the payload "
+      "JSON (model 'joint_torques', determined_by_torques, not_excited, ...).");
 
   m.def(
       "export_urdf",

@@ -12,15 +12,16 @@ M2, LC2, I2 = 1.5, 0.4, 0.08
 L1, G = 1.0, 9.81
 
 
-def planar2_torques(q, dq, ddq):
-    """Closed-form inverse dynamics of the planar 2R arm (Spong, Hutchinson, Vidyasagar ch. 7)."""
+def planar2_torques(q, dq, ddq, m2=M2, lc2=LC2, i2=I2):
+    """Closed-form inverse dynamics of the planar 2R arm (Spong, Hutchinson, Vidyasagar ch. 7);
+    m2, lc2, i2: the forearm's mass, centre of mass on its x axis and inertia about it."""
     c2, s2 = np.cos(q[:, 1]), np.sin(q[:, 1])
-    m11 = I1 + M1 * LC1**2 + I2 + M2 * (L1**2 + LC2**2 + 2 * L1 * LC2 * c2)
-    m12 = I2 + M2 * (LC2**2 + L1 * LC2 * c2)
-    m22 = I2 + M2 * LC2**2
-    h = M2 * L1 * LC2 * s2
-    g1 = (M1 * LC1 + M2 * L1) * G * np.cos(q[:, 0]) + M2 * LC2 * G * np.cos(q[:, 0] + q[:, 1])
-    g2 = M2 * LC2 * G * np.cos(q[:, 0] + q[:, 1])
+    m11 = I1 + M1 * LC1**2 + i2 + m2 * (L1**2 + lc2**2 + 2 * L1 * lc2 * c2)
+    m12 = i2 + m2 * (lc2**2 + L1 * lc2 * c2)
+    m22 = i2 + m2 * lc2**2
+    h = m2 * L1 * lc2 * s2
+    g1 = (M1 * LC1 + m2 * L1) * G * np.cos(q[:, 0]) + m2 * lc2 * G * np.cos(q[:, 0] + q[:, 1])
+    g2 = m2 * lc2 * G * np.cos(q[:, 0] + q[:, 1])
     tau1 = m11 * ddq[:, 0] + m12 * ddq[:, 1] - h * (2 * dq[:, 0] * dq[:, 1] + dq[:, 1] ** 2) + g1
     tau2 = m12 * ddq[:, 0] + m22 * ddq[:, 1] + h * dq[:, 0] ** 2 + g2
     return np.column_stack([tau1, tau2])
