@@ -220,6 +220,14 @@ PhysicalFit physical_parameters(const Model& nominal, const BaseParameters& base
   // they are base parameters themselves, else nominal.
   double max_mass = 0.0;
   for (int l = 0; l < n; ++l) max_mass = std::max(max_mass, theta_nom[10 * l + 9]);
+  // The fit is drawn towards the nominal links, and its distance is relative to them: a model
+  // with no mass anywhere (a URDF without <inertial> blocks) gives neither a target nor a scale.
+  if (!(max_mass > 0.0)) {
+    throw Error("physical parameters: the nominal model '" + nominal.name +
+                "' has no mass on any moving link (a URDF without <inertial> blocks?); the "
+                "consistent fit stays as close as the data allow to the nominal inertias, so "
+                "give each link's nominal <inertial> (CAD, datasheet)");
+  }
   const double min_mass = 1e-3 * std::max(max_mass, 1.0);
   Eigen::VectorXd phi(P);
   for (int l = 0; l < n; ++l) {

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -203,6 +204,35 @@ TEST_F(ExportCli, RefusesResultsItCannotExport) {
   j = result_;
   j["standard_parameters"][0]["name"] = "QQ1";
   expect_refused(j, "'QQ1' is not a standard parameter name");
+}
+
+// identify --physical with a URDF that has no <inertial> blocks (issue 15 item 8): the fit has
+// no nominal inertias to stay close to, so one error line, exit 1, and no result file, instead of
+// a "distance to the nominal model" divided by zero.
+TEST_F(ExportCli, PhysicalFitRefusesAUrdfWithoutInertials) {
+  std::string text = kUrdf;
+  for (std::size_t a; (a = text.find("<inertial>")) != std::string::npos;)
+    text.erase(a, text.find("</inertial>", a) + std::string("</inertial>").size() - a);
+  const std::string bare = work("bare.urdf");
+  std::ofstream(bare) << text;
+  std::ofstream data(work("run.csv"));
+  data << "t,q1,q2,dq1,dq2,ddq1,ddq2,tau1,tau2\n";
+  for (int k = 0; k < 2000; ++k) {  // any smooth motion and torque: the fit is refused before use
+    const double t = 0.01 * k, s1 = std::sin(0.9 * t), s2 = std::sin(1.7 * t + 0.4);
+    data << t << ',' << s1 << ',' << s2 << ',' << 0.9 * std::cos(0.9 * t) << ','
+         << 1.7 * std::cos(1.7 * t + 0.4) << ',' << -0.81 * s1 << ',' << -2.89 * s2 << ','
+         << 0.3 * s1 + 0.05 * std::cos(5.0 * t) << ',' << 0.2 * s2 + 0.04 * std::sin(4.0 * t)
+         << '\n';
+  }
+  data.close();
+  const auto r = run("identify --robot " + bare + " --data " + work("run.csv") +
+                     " --filter none --friction viscous --physical --out " + work("p.json"));
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(testing::error_contract_problem(r.err), "") << r.err;
+  EXPECT_NE(r.err.find("has no mass on any moving link (a URDF without <inertial> blocks?)"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(work("p.json")));
 }
 
 }  // namespace

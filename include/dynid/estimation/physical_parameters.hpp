@@ -61,8 +61,9 @@ struct PhysicalFit {
 /// ‖L⁻¹(θ_b(φ) − θ̂_b)‖² + prior_weight·Σ((θ_i − θ_nom,i)/s_i)² (C = L·Lᵀ) by Levenberg–
 /// Marquardt (Ceres) from the nominal model. `base`: compute_base_parameters() of `nominal` with
 /// `layout` (and coupling as in the identification). Throws dynid::Error for sizes that do not
-/// match, a covariance that is not positive definite, and when no consistent set lies within the
-/// χ² limit (the message says how far, in σ).
+/// match, a covariance that is not positive definite, a nominal model without mass on any moving
+/// link (nothing to stay close to), and when no consistent set lies within the χ² limit (the
+/// message says how far, in σ).
 PhysicalFit physical_parameters(const Model& nominal, const BaseParameters& base,
                                 const ParameterLayout& layout, const Eigen::VectorXd& theta_b,
                                 const Eigen::MatrixXd& covariance,
