@@ -24,6 +24,7 @@
 #include "dynid/io/urdf_export.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
+#include "dynid/report/html_report.hpp"
 #include "dynid/report/identification_report.hpp"
 #include "dynid/report/payload_report.hpp"
 #include "dynid/version.hpp"
@@ -356,10 +357,10 @@ nlohmann::json payload_from_orientation(const std::optional<Eigen::VectorXd>& t,
   return solve_load(motion, wrench, k, {{"orientation", "qx qy qz qw from the data"}}, choices);
 }
 
-// The identify options that rebuild a reference result's regressor and filtering (`dynid
-// payload --reference result.json`, as `dynid validate` reads the file): friction set and
-// armature from its `options` (a dynid.identify dict or the command line's result.json), the
-// cut-off and zero-velocity thresholds identify used.
+// The identify options that rebuild a result's regressor and filtering, as `dynid validate` and
+// `dynid payload --reference result.json` read the file: friction set, armature, filter,
+// Savitzky-Golay and filtered Coulomb columns from its `options` (a dynid.identify dict or the
+// command line's result.json), the cut-off and zero-velocity thresholds identify used.
 IdentifyOptions options_of_result(const IdentifiedResultFile& identified) {
   const nlohmann::json& o = identified.options;
   const auto flag = [&](const char* key, bool fallback) {
@@ -379,21 +380,16 @@ IdentifyOptions options_of_result(const IdentifiedResultFile& identified) {
   if (o.contains("filter") && o["filter"].is_string()) {  // the command line's --filter
     const std::string filter = o["filter"].get<std::string>();
     if (filter != "auto" && filter != "none") {
-      throw Error("the reference result was filtered with --filter " + filter +
-                  ", which only the command line rebuilds; use dynid payload --reference "
-                  "result.json");
+      throw Error("the result was filtered with --filter " + filter +
+                  ", which only the command line rebuilds; use dynid validate or dynid payload "
+                  "--reference result.json");
     }
     options.signal.filter = filter == "auto";
   } else {
     options.signal.filter = flag("filter", true);
   }
-  for (const char* key : {"savitzky_golay", "filter_coulomb_columns"}) {
-    if (flag(key, false)) {
-      throw Error(std::string("the reference result was identified with ") + key +
-                  ", which only the command line rebuilds; use dynid payload --reference "
-                  "result.json");
-    }
-  }
+  options.signal.savitzky_golay = flag("savitzky_golay", false);
+  options.signal.filter_coulomb_columns = flag("filter_coulomb_columns", false);
   options.signal.cutoff_hz =
       identified.cutoff_hz > 0.0
           ? identified.cutoff_hz
@@ -407,6 +403,21 @@ IdentifyOptions options_of_result(const IdentifiedResultFile& identified) {
   if (o.contains("torque_offset_s") && o["torque_offset_s"].is_number())
     options.signal.torque_time_offset = o["torque_offset_s"].get<double>();
   return options;
+}
+
+// An identify result dict (dynid.identify's, or a result.json loaded with json.load) read with
+// the checks of read_identification_result; a result of another robot is an error, as on the
+// command line.
+IdentifiedResultFile identified_result(const Model& model, const py::dict& result,
+                                       const std::string& what) {
+  const nlohmann::json j =
+      nlohmann::json::parse(py::module_::import("json").attr("dumps")(result).cast<std::string>());
+  IdentifiedResultFile identified = identification_result_from_json(j, what);
+  if (!identified.robot.empty() && identified.robot != model.name) {
+    throw Error("the " + what + " is of robot '" + identified.robot + "', not '" + model.name +
+                "'; give a result of this robot");
+  }
+  return identified;
 }
 
 // payload_from_torques(): a load without a sensor, as `dynid payload --robot R --link L
@@ -442,13 +453,7 @@ nlohmann::json payload_from_torques(const Model& model, const std::string& link_
           "cutoff_hz and filter come from the reference result (the loaded run is filtered as "
           "identify filtered the unloaded one); drop them");
     }
-    const nlohmann::json j = nlohmann::json::parse(
-        py::module_::import("json").attr("dumps")(reference).cast<std::string>());
-    const IdentifiedResultFile identified = identification_result_from_json(j, "reference");
-    if (!identified.robot.empty() && identified.robot != model.name) {
-      throw Error("the reference result is of robot '" + identified.robot + "', not '" +
-                  model.name + "'; give a result of the robot that carries the load");
-    }
+    const IdentifiedResultFile identified = identified_result(model, reference, "reference");
     const IdentifyOptions identify = options_of_result(identified);
     // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
     options.hac_covariance = identify.signal.filter;
@@ -643,26 +648,33 @@ PYBIND11_MODULE(dynid, m) {
       [](const Model& model, const py::dict& result, const Eigen::VectorXd& t, const Samples& q,
          const Samples& tau, const std::optional<RowMatrix>& dq,
          const std::optional<RowMatrix>& ddq, const py::kwargs& kw) {
+        const IdentifiedResultFile identified = identified_result(model, result, "result");
         nlohmann::json used;
-        const IdentifyOptions options = identify_options(kw, used);
+        const IdentifyOptions options =
+            kw.empty() ? options_of_result(identified) : identify_options(kw, used);
         const JointRecord record = record_of(model, t, q, tau, dq, ddq);
-        std::vector<std::string> names;
-        std::vector<double> values;
-        for (const auto& p : result["parameters"].cast<py::list>()) {
-          names.push_back(p["name"].cast<std::string>());
-          values.push_back(p["value"].cast<double>());
+        ValidationResult v;
+        {
+          py::gil_scoped_release release;
+          v = validate_torques(model, record, identified.names, identified.values, options,
+                               identified.not_excited);
         }
-        const ValidationResult v =
-            validate_torques(model, record, names,
-                             Eigen::Map<const Eigen::VectorXd>(
-                                 values.data(), static_cast<Eigen::Index>(values.size())),
-                             options);
-        return to_python(validation_to_json(model, v));
+        std::vector<std::string> joints;
+        for (const auto& joint : model.joints) joints.push_back(joint.name);
+        nlohmann::json out = validation_to_json(model, v);
+        out["plot"] = prediction_plot_json(v, joints);
+        return to_python(out);
       },
       py::arg("model"), py::arg("result"), py::arg("t"), py::arg("q"), py::arg("tau"),
       py::arg("dq") = py::none(), py::arg("ddq") = py::none(),
-      "Prediction errors of an identify() result on another run, as 'dynid validate': give the "
-      "same options as to identify(). Returns a dict with the keys of the validate JSON.");
+      "Prediction errors of an identify() result (a dynid.identify dict, or the command line's "
+      "result.json loaded with json.load) on another run, as 'dynid validate --json': t (m,) [s], "
+      "q and tau (m x n), optional dq, ddq. Without options the run is processed as identify "
+      "processed its own (the result's friction set, armature and filter, the cut-off and "
+      "zero-velocity thresholds identify used), as the command line does; or give the same "
+      "keyword options as to identify() to set them all. Returns a dict with the keys of the "
+      "validate JSON, 'plot' (measured and predicted torques, residual histogram) included. A "
+      "result of another robot is a dynid.Error.");
 
   m.def(
       "payload",

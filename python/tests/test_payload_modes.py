@@ -296,10 +296,40 @@ def test_payload_modes_refuse_bad_input_with_a_message():
         dynid.payload_from_torques(planar2, "forearm2", t1, q1, tau1,
                                    {"t": t1, "q": q1, "tau": tau1})
     other = {"model": {"name": "puma560"}, "parameters": [{"name": "ZZ1R", "value": 1.0}]}
-    with pytest.raises(dynid.Error, match="robot 'puma560', not 'planar2'"):
+    with pytest.raises(dynid.Error, match="reference is of robot 'puma560', not 'planar2'"):
         dynid.payload_from_torques(planar2, "forearm", t1, q1, tau1, other)
     with pytest.raises(ValueError, match="cutoff_hz and filter come from the reference"):
         dynid.payload_from_torques(planar2, "forearm", t1, q1, tau1, other, filter=False)
     with pytest.raises(ValueError, match="frame must be"):
         dynid.payload_from_torques(planar2, "forearm", t1, q1, tau1,
                                    {"t": t1, "q": q1, "tau": tau1}, frame=[0, 0, 0])
+
+
+def test_validate_processes_the_run_as_the_command_line_does(tmp_path):
+    """dynid.validate without options rebuilds identify's processing from the result (friction
+    set, filter, the cut-off and zero-velocity thresholds identify used), as `dynid validate`."""
+    planar2 = dynid.load_model("planar2")
+    rng = np.random.default_rng(19)
+    columns = ["t", "q1", "q2", "tau1", "tau2"]
+    paths = []
+    for seed in (20, 21):
+        t, q, dq, ddq = fourier_run(seed, samples=1500)
+        tau = planar2_torques(q, dq, ddq) + rng.normal(0.0, 0.05, size=q.shape)
+        paths.append((tmp_path / f"run{seed}.csv", t, q, tau))
+        np.savetxt(paths[-1][0], np.column_stack([t, q, tau]), delimiter=",",
+                   header=",".join(columns), comments="", fmt="%.17g")
+    identified, validated = tmp_path / "id.json", tmp_path / "val.json"
+    for args in (["identify", "--robot", "planar2", "--data", str(paths[0][0]), "--friction",
+                  "viscous", "--out", str(identified)],
+                 ["validate", "--robot", "planar2", "--params", str(identified), "--data",
+                  str(paths[1][0]), "--json", str(validated)]):
+        run = subprocess.run([binary(), *args], capture_output=True, text=True, check=False)
+        assert run.returncode == 0, run.stderr
+    result = json.loads(identified.read_text())
+    _, t, q, tau = paths[1]
+    ours = dynid.validate(planar2, result, t, q, tau)
+    assert_same(ours, json.loads(validated.read_text()))
+    assert 0.0 < ours["relative_error"] < 0.05
+    other = dict(result, model=dict(result["model"], name="puma560"))
+    with pytest.raises(dynid.Error, match="result is of robot 'puma560', not 'planar2'"):
+        dynid.validate(planar2, other, t, q, tau)
