@@ -18,12 +18,14 @@
 #include "dynid/dynamics/rnea.hpp"
 #include "dynid/estimation/identification.hpp"
 #include "dynid/estimation/load_identification.hpp"
+#include "dynid/estimation/physical_parameters.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
 #include "dynid/io/atomic_file.hpp"
 #include "dynid/io/model_summary.hpp"
 #include "dynid/io/urdf_export.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
+#include "dynid/report/experiment_report.hpp"
 #include "dynid/report/html_report.hpp"
 #include "dynid/report/identification_report.hpp"
 #include "dynid/report/payload_report.hpp"
@@ -131,11 +133,16 @@ void check_keywords(const py::kwargs& kw, const char* const (&keys)[N]) {
   }
 }
 
-IdentifyOptions identify_options(const py::kwargs& kw, nlohmann::json& used) {
+// `physical` (identify only): where to put identify's --physical, else that keyword is refused.
+IdentifyOptions identify_options(const py::kwargs& kw, nlohmann::json& used,
+                                 bool* physical = nullptr) {
   static const char* const kKeys[] = {"armature",   "viscous",   "coulomb",    "offset",
                                       "asymmetric", "estimator", "confidence", "cutoff_hz",
-                                      "filter",     "decimate"};
+                                      "filter",     "decimate",  "physical"};
   check_keywords(kw, kKeys);
+  if (!physical && kw.contains("physical")) {
+    throw py::type_error("physical is an option of identify(), not of validate()");
+  }
   auto get = [&](const char* key, auto fallback) {
     using T = decltype(fallback);
     const T value = kw.contains(key) ? kw[key].cast<T>() : fallback;
@@ -151,6 +158,7 @@ IdentifyOptions identify_options(const py::kwargs& kw, nlohmann::json& used) {
   o.signal.cutoff_hz = get("cutoff_hz", 0.0);
   o.signal.filter = get("filter", true);
   o.signal.decimate = get("decimate", 0);
+  if (physical) *physical = get("physical", false);
   return o;
 }
 
@@ -625,14 +633,45 @@ PYBIND11_MODULE(dynid, m) {
          const std::optional<RowMatrix>& dq, const std::optional<RowMatrix>& ddq,
          const py::kwargs& kw) {
         nlohmann::json used;
-        const IdentifyOptions options = identify_options(kw, used);
+        bool physical = false;
+        const IdentifyOptions options = identify_options(kw, used, &physical);
         const JointRecord record = record_of(model, t, q, tau, dq, ddq);
-        IdentificationResult result;
-        {
-          py::gil_scoped_release release;
-          result = identify(model, record, options);
+        py::gil_scoped_release release;
+        const IdentificationResult result = identify(model, record, options);
+        nlohmann::json out = identification_to_json(model, result, used);
+        // As the command line: the run replayed with the estimate (the `plot` a report draws,
+        // and the unconstrained torque error beside the consistent one), the RLS history.
+        IdentifyOptions same = options;
+        same.signal.cutoff_hz = result.processed.cutoff_hz;
+        std::optional<ValidationResult> replay;
+        try {
+          replay = validate_torques(model, record, result.names, result.estimate.x, same,
+                                    result.not_excited);
+          std::vector<std::string> joints;
+          for (const auto& joint : model.joints) joints.push_back(joint.name);
+          out["plot"] = prediction_plot_json(*replay, joints);
+        } catch (const Error&) {  // the result stands without its plot (e.g. nothing excited)
         }
-        return to_python(identification_to_json(model, result, used));
+        if (result.history_x.rows() > 0) out["plot"]["history"] = rls_history_plot_json(result);
+        if (physical) {
+          if (!result.not_excited.empty()) {
+            throw Error("physical=True needs every base parameter determined by the data; " +
+                        result.not_excited.front() +
+                        " is not excited (record a run that moves "
+                        "every joint)");
+          }
+          const PhysicalFit fit = physical_parameters(
+              model, result.base, options.layout, result.estimate.x, result.estimate.covariance);
+          const double physical_error =
+              validate_torques(model, record, result.names, fit.theta_b, same).relative_error_all;
+          const double free_error =
+              replay ? replay->relative_error_all
+                     : validate_torques(model, record, result.names, result.estimate.x, same)
+                           .relative_error_all;
+          physical_parameters_to_json(fit, physical_error, free_error, out);
+        }
+        py::gil_scoped_acquire acquire;
+        return to_python(out);
       },
       py::arg("model"), py::arg("t"), py::arg("q"), py::arg("tau"), py::arg("dq") = py::none(),
       py::arg("ddq") = py::none(),
@@ -640,8 +679,10 @@ PYBIND11_MODULE(dynid, m) {
       "(m,) [s], q and tau (m x n), optional dq, ddq (derived from q when absent). Options: "
       "armature, viscous, coulomb, offset, asymmetric (bool: the per-joint columns), estimator "
       "('ols', 'wls', 'rls'), confidence (0.999), cutoff_hz (0 = automatic), filter (bool), "
-      "decimate (0 = automatic). Returns a dict with the keys of the result JSON (parameters, "
-      "condition_number, residual_rms, ...).");
+      "decimate (0 = automatic), physical (bool, --physical: also physically consistent standard "
+      "parameters, log-Cholesky fit of C. Rucker, P. M. Wensing, 2022, for export_urdf). Returns "
+      "a dict with the keys of the result JSON (parameters, condition_number, residual_rms, "
+      "plot, and with physical standard_parameters, physically_consistent, physical).");
 
   m.def(
       "validate",

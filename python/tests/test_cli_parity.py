@@ -1,8 +1,9 @@
-"""The modes of `dynid payload` through Python (issue 15 item 4): each mode's dict against the JSON
-of the command line on the same data (the command line reads a CSV and parses its flags, an
-independent path through the argument handling), and the load recovered inside its intervals
-from data made here in NumPy by the Newton-Euler equations of the load, or by the closed-form
-planar 2R arm, not by dynid's load regressor."""
+"""The Python module against the command line (issue 15 item 4): each mode of `dynid payload`,
+`validate` and `identify --physical` give the same dict as the command's JSON on the same data
+(the command line reads a CSV and parses its flags, an independent path through the argument
+handling), and the load is recovered inside its intervals from data made here in NumPy by the
+Newton-Euler equations of the load, or by the closed-form planar 2R arm, not by dynid's load
+regressor."""
 import json
 import os
 import subprocess
@@ -333,3 +334,34 @@ def test_validate_processes_the_run_as_the_command_line_does(tmp_path):
     other = dict(result, model=dict(result["model"], name="puma560"))
     with pytest.raises(dynid.Error, match="result is of robot 'puma560', not 'planar2'"):
         dynid.validate(planar2, other, t, q, tau)
+
+
+def test_identify_physical_and_its_plot_as_the_command_line(tmp_path):
+    """identify(physical=True): the consistent standard parameters, their distance and the plot
+    section equal those of `dynid identify --physical`; export_urdf writes them loadably."""
+    planar2 = dynid.load_model("planar2")
+    rng = np.random.default_rng(22)
+    t, q, dq, ddq = fourier_run(23, samples=1500)
+    tau = planar2_torques(q, dq, ddq) + rng.normal(0.0, 0.05, size=q.shape)
+    data, out = tmp_path / "run.csv", tmp_path / "id.json"
+    np.savetxt(data, np.column_stack([t, q, dq, ddq, tau]), delimiter=",", comments="",
+               header="t,q1,q2,dq1,dq2,ddq1,ddq2,tau1,tau2", fmt="%.17g")
+    run = subprocess.run([binary(), "identify", "--robot", "planar2", "--data", str(data),
+                          "--friction", "none", "--no-armature", "--filter", "none",
+                          "--physical", "--out", str(out)],
+                         capture_output=True, text=True, check=False)
+    assert run.returncode == 0, run.stderr
+    expected = json.loads(out.read_text())
+    ours = dynid.identify(planar2, t, q, tau, dq=dq, ddq=ddq, armature=False, viscous=False,
+                          coulomb=False, offset=False, filter=False, physical=True)
+    for key in ("parameters", "standard_parameters", "physically_consistent", "physical",
+                "plot"):
+        assert_same(ours[key], expected[key], key)
+    assert ours["options"]["physical"] is True
+    urdf = tmp_path / "identified.urdf"
+    dynid.export_urdf(planar2, ours, str(urdf))
+    exported = dynid.load_model(str(urdf))
+    masses = [p["value"] for p in ours["standard_parameters"] if p["name"] in ("M1", "M2")]
+    np.testing.assert_allclose(exported.standard_parameters[[9, 19]], masses, rtol=1e-12)
+    with pytest.raises(TypeError, match="physical is an option of identify"):
+        dynid.validate(planar2, ours, t, q, tau, physical=True)
