@@ -20,6 +20,7 @@ struct DemoCliOptions {
   bool native = false;
   unsigned seed = 7;
   std::string report;  // --report; default <out>/report.html
+  bool quiet = false;  // --quiet: no stage lines on stderr
 };
 
 std::string default_folder() {
@@ -46,7 +47,7 @@ void run(const DemoCliOptions& c) {
   const DemoResult r = run_demo(o, [&](const std::string& line) {
     const double s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::cerr << "[" << static_cast<int>(s) << " s] " << line << std::endl;
+    if (!c.quiet) std::cerr << "[" << static_cast<int>(s) << " s] " << line << std::endl;
   });
   // The report of the files the demo wrote, as `dynid report --in` would make it.
   const std::filesystem::path dir(o.out_dir);
@@ -78,6 +79,7 @@ void add_demo_command(CLI::App& app) {
   cmd->add_option("--report", c->report,
                   "HTML report of the run (excitation, identification, validation); default "
                   "report.html in the output folder");
+  cmd->add_flag("--quiet,-q", c->quiet, "No stage lines (elapsed time, stage) on stderr");
   cmd->callback([c] { run(*c); });
 }
 

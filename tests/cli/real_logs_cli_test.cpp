@@ -404,10 +404,12 @@ TEST_F(RealLogsCli, NoIdentityExpressionsAndAlignedTables) {
 }
 
 // Item 4: the demo prints the validation error over every row first, the near-still-free one
-// second, and validates with the thresholds its identification used.
+// second, and validates with the thresholds its identification used. --quiet: no stage lines.
 TEST_F(RealLogsCli, DemoLeadsWithTheErrorOverEveryRow) {
-  const CliRun demo = run("demo --robot planar2 --native --periods 4 --out " + path("demo"));
+  const CliRun demo =
+      run("demo --robot planar2 --native --periods 4 --quiet --out " + path("demo"));
   ASSERT_EQ(demo.code, 0) << demo.err;
+  EXPECT_EQ(demo.err, "");
   const auto every = demo.out.find("relative torque error over every row");
   const auto still = demo.out.find("without the");
   ASSERT_NE(every, std::string::npos) << demo.out;
