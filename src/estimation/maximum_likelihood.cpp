@@ -417,6 +417,13 @@ MeasurementNoise processed_noise(const SensorNoise& given, const SignalOptions& 
   };
   check(given.q, "position");
   check(given.tau, "torque");
+  for (Eigen::Index j = 0; j < given.tau.size(); ++j)
+    if (!(given.tau[j] > 0.0))
+      throw Error(
+          "maximum likelihood needs a torque noise standard deviation > 0 for every joint; the "
+          "given one of joint " +
+          std::to_string(j + 1) + " is 0 (--noise-std tau=0, or a --noise FILE whose tau" +
+          std::to_string(j + 1) + " std is 0): give a std > 0");
   Eigen::VectorXd sq = given.q, st = given.tau;
   std::string source_q = "given", source_tau = "given";
   if (sq.size() == 0) {
