@@ -42,28 +42,56 @@ Eigen::MatrixXd differential_sensitivity(const Model& model, const ParameterLayo
     }
   }
   const auto p = static_cast<Eigen::Index>(columns.size());
-  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(3 * n * rows, p);
-  ProcessedRecord work = processed;
-  Eigen::MatrixXd* channel[3] = {&work.record.q, &work.record.dq, &work.record.ddq};
-  const Eigen::MatrixXd* original[3] = {&processed.record.q, &processed.record.dq,
-                                        &processed.record.ddq};
-  for (int c = 0; c < 3; ++c) {
-    // W is quadratic in q̇ and linear in q̈, so central differences are exact for any step; for q
-    // the step balances the O(h²) truncation against rounding (relative ~1e-10).
-    const double h = c == 0 ? 1e-5 : 1e-2;
-    for (int j = 0; j < n; ++j) {
-      channel[c]->col(j) = original[c]->col(j).array() + h;
-      const Eigen::MatrixXd plus = processed_regressor(model, layout, coupling, work);
-      channel[c]->col(j) = original[c]->col(j).array() - h;
-      const Eigen::MatrixXd minus = processed_regressor(model, layout, coupling, work);
-      channel[c]->col(j) = original[c]->col(j);
-      for (Eigen::Index i = 0; i < rows; ++i) {
-        const Eigen::Index r = static_cast<Eigen::Index>(sample[i]) * n + joint[i];
-        for (Eigen::Index k = 0; k < p; ++k) {
-          out(3 * n * i + c * n + j, k) = (plus(r, columns[k]) - minus(r, columns[k])) / (2.0 * h);
+  // Every entry is written below. The record is differentiated in chunks of samples (row k of W
+  // depends on sample k only), so the perturbed regressors stay small instead of 6n copies of
+  // the whole record's regressor (megabytes each, page-faulted afresh).
+  Eigen::MatrixXd out(3 * n * rows, p);
+  std::vector<Eigen::Index> order(static_cast<std::size_t>(rows));
+  for (Eigen::Index i = 0; i < rows; ++i) order[static_cast<std::size_t>(i)] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](Eigen::Index a, Eigen::Index b) { return sample[a] < sample[b]; });
+  constexpr Eigen::Index kChunk = 32;
+  const bool coulomb = processed.moving_positive.size() > 0;
+  ProcessedRecord work;
+  std::size_t next = 0;  // first entry of `order` not yet written
+  for (Eigen::Index k0 = 0; k0 < m && next < order.size(); k0 += kChunk) {
+    const Eigen::Index len = std::min(kChunk, m - k0);
+    if (sample[order[next]] >= k0 + len) continue;  // no rows in this chunk
+    work.record.t = processed.record.t.segment(k0, len);
+    work.record.q = processed.record.q.middleRows(k0, len);
+    work.record.dq = processed.record.dq.middleRows(k0, len);
+    work.record.ddq = processed.record.ddq.middleRows(k0, len);
+    if (coulomb) {
+      work.moving_positive = processed.moving_positive.middleRows(k0, len);
+      work.moving_negative = processed.moving_negative.middleRows(k0, len);
+    }
+    std::size_t end = next;
+    while (end < order.size() && sample[order[end]] < k0 + len) ++end;
+    Eigen::MatrixXd* channel[3] = {&work.record.q, &work.record.dq, &work.record.ddq};
+    const Eigen::MatrixXd* original[3] = {&processed.record.q, &processed.record.dq,
+                                          &processed.record.ddq};
+    for (int c = 0; c < 3; ++c) {
+      // W is quadratic in q̇ and linear in q̈, so central differences are exact for any step; for
+      // q the step balances the O(h²) truncation against rounding (relative ~1e-10).
+      const double h = c == 0 ? 1e-5 : 1e-2;
+      for (int j = 0; j < n; ++j) {
+        const auto base = original[c]->col(j).segment(k0, len);
+        channel[c]->col(j) = base.array() + h;
+        const Eigen::MatrixXd plus = processed_regressor(model, layout, coupling, work);
+        channel[c]->col(j) = base.array() - h;
+        const Eigen::MatrixXd minus = processed_regressor(model, layout, coupling, work);
+        channel[c]->col(j) = base;
+        for (std::size_t o = next; o < end; ++o) {
+          const Eigen::Index i = order[o];
+          const Eigen::Index r = static_cast<Eigen::Index>(sample[i] - k0) * n + joint[i];
+          for (Eigen::Index k = 0; k < p; ++k) {
+            out(3 * n * i + c * n + j, k) =
+                (plus(r, columns[k]) - minus(r, columns[k])) / (2.0 * h);
+          }
         }
       }
     }
+    next = end;
   }
   return out;
 }
@@ -98,13 +126,15 @@ class SampleCost : public ceres::CostFunction {
   bool whiten(const Eigen::Ref<const Eigen::VectorXd>& theta, Eigen::Ref<Eigen::VectorXd> residual,
               Eigen::MatrixXd* whitened_rows = nullptr, Eigen::VectorXd* whitened_y = nullptr,
               Eigen::MatrixXd* jacobian = nullptr) const {
-    const Eigen::Index r = rows_.count, n3 = var_x_.size(), p = block_.W.cols();
+    const Eigen::Index r = rows_.count, n3 = var_x_.size();
     const auto W = block_.W.middleRows(rows_.first, r);
     const Eigen::VectorXd b = block_.y.segment(rows_.first, r) - W * theta;
-    Eigen::MatrixXd J(r, n3);
-    for (Eigen::Index a = 0; a < r; ++a) {
-      J.row(a) = (sensitivity_.middleRows(n3 * (rows_.first + a), n3) * theta).transpose();
-    }
+    // The sensitivity blocks of the sample's rows are contiguous: row a·n3 + c of `stacked` is
+    // ∂W_a/∂x_c, so one product gives J row-major (J(a, c) = ∂(W_a θ)/∂x_c).
+    const auto stacked = sensitivity_.middleRows(n3 * rows_.first, n3 * r);
+    const Eigen::VectorXd j_flat = stacked * theta;
+    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>
+        J(j_flat.data(), r, n3);
     const Eigen::MatrixXd A = J * var_x_.asDiagonal();
     Eigen::MatrixXd S = A * J.transpose();
     S.diagonal() += var_tau_row_.segment(rows_.first, r);
@@ -116,21 +146,26 @@ class SampleCost : public ceres::CostFunction {
     if (whitened_y) *whitened_y = L.solve(block_.y.segment(rows_.first, r));
     if (jacobian) {
       jacobian->noalias() = -L.solve(W);
-      const Eigen::MatrixXd At = L.solve(A);  // L⁻¹A, r × n3
-      // D of every parameter side by side: column k·n3 + c of row a is ∂J(a, c)/∂θ_k.
-      Eigen::MatrixXd D(r, n3 * p);
+      // Φ(L⁻¹∂S_k L⁻ᵀ)·res, row a, is linear in D_k: Σ_c Dt_k(a,c)·G(a,c) + Σ_c At(a,c)·H_k(a,c)
+      // with Dt_k = L⁻¹D_k, G(a,·) = Σ_{b≤a} w_ab·res_b·At(b,·), H_k(a,·) = Σ_{b≤a} w_ab·res_b·
+      // Dt_k(b,·), w = 1 below the diagonal and ½ on it (Φ). With P = Φ-weighted prefix sums of
+      // res_b·L⁻¹(b,·), H_k = P·D_k, so the term of every θ_k is Z·stacked with
+      // Z(a, e·n3 + c) = L⁻¹(a,e)·G(a,c) + P(a,e)·At(a,c): one r × r·n3 by r·n3 × p product
+      // instead of p triangular solves and r × r products.
+      const Eigen::MatrixXd Linv = L.solve(Eigen::MatrixXd::Identity(r, r));
+      const Eigen::MatrixXd At = Linv.triangularView<Eigen::Lower>() * A;  // L⁻¹A, r × n3
+      Eigen::MatrixXd G(r, n3), P(r, r), Z = Eigen::MatrixXd::Zero(r, r * n3);
+      Eigen::RowVectorXd g_sum = Eigen::RowVectorXd::Zero(n3), p_sum = Eigen::RowVectorXd::Zero(r);
       for (Eigen::Index a = 0; a < r; ++a) {
-        const auto s = sensitivity_.middleRows(n3 * (rows_.first + a), n3);
-        for (Eigen::Index k = 0; k < p; ++k) D.block(a, k * n3, 1, n3) = s.col(k).transpose();
+        G.row(a) = g_sum + 0.5 * residual[a] * At.row(a);
+        g_sum += residual[a] * At.row(a);
+        P.row(a) = p_sum + 0.5 * residual[a] * Linv.row(a);
+        p_sum += residual[a] * Linv.row(a);
+        for (Eigen::Index e = 0; e <= a; ++e) {
+          Z.block(a, e * n3, 1, n3) = Linv(a, e) * G.row(a) + P(a, e) * At.row(a);
+        }
       }
-      L.solveInPlace(D);  // L⁻¹D_k
-      Eigen::MatrixXd M(r, r);
-      for (Eigen::Index k = 0; k < p; ++k) {
-        M.noalias() = D.middleCols(k * n3, n3) * At.transpose();
-        M += M.transpose().eval();
-        M.diagonal() *= 0.5;
-        jacobian->col(k) -= M.triangularView<Eigen::Lower>() * residual;
-      }
+      jacobian->noalias() -= Z * stacked;
     }
     return true;
   }
@@ -382,6 +417,13 @@ MeasurementNoise processed_noise(const SensorNoise& given, const SignalOptions& 
   };
   check(given.q, "position");
   check(given.tau, "torque");
+  for (Eigen::Index j = 0; j < given.tau.size(); ++j)
+    if (!(given.tau[j] > 0.0))
+      throw Error(
+          "maximum likelihood needs a torque noise standard deviation > 0 for every joint; the "
+          "given one of joint " +
+          std::to_string(j + 1) + " is 0 (--noise-std tau=0, or a --noise FILE whose tau" +
+          std::to_string(j + 1) + " std is 0): give a std > 0");
   Eigen::VectorXd sq = given.q, st = given.tau;
   std::string source_q = "given", source_tau = "given";
   if (sq.size() == 0) {
