@@ -22,6 +22,7 @@
 #include <cstdlib>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
@@ -65,6 +66,43 @@ ClosedLoopResult run(const Model& model, unsigned seed, double ts) {
   return r;
 }
 
+// The puma560 of the studies, with friction Ia, Fv, Fc, Fo on every joint.
+Model puma_with_friction() {
+  Model model = load_robot("puma560");
+  for (int j = 0; j < model.dof(); ++j) {
+    model.joints[j].friction = {0.05 * (j + 1), 0.5 + 0.1 * j, 0.3 + 0.1 * j, 0.1 * (j + 1)};
+  }
+  return model;
+}
+
+// The record processed as integral_signal_options() does, at another cut-off [Hz].
+ProcessedRecord processed_at(const JointRecord& record, double cutoff) {
+  SignalOptions so = integral_signal_options();
+  so.cutoff_hz = cutoff;
+  std::vector<std::pair<std::string, std::string>> choices;
+  return preprocess(record, so, choices);
+}
+
+// Of the TX40's 12 joint friction values (Fv_j, Fc_j) in the estimate x of `base`, how many are
+// within 10 % of the published ones, and the largest relative error.
+std::pair<int, double> tx40_friction_score(const integral_testing::Tx40Run& run,
+                                           const BaseParameters& base, const Eigen::VectorXd& x) {
+  int within = 0;
+  double worst = 0.0;
+  for (int j = 0; j < 6; ++j) {
+    for (const char* kind : {"v", "c"}) {
+      const std::string name = std::string("F") + kind + std::to_string(j + 1);
+      const double truth = run.published[kind[0] == 'v' ? "fv" : "fs"][j].as<double>();
+      const Eigen::Index i =
+          std::find(base.names.begin(), base.names.end(), name) - base.names.begin();
+      const double err = std::abs(x[i] - truth) / truth;
+      within += err <= 0.1;
+      worst = std::max(worst, err);
+    }
+  }
+  return {within, worst};
+}
+
 // Rows [first, first + m) of the true run as a processed record.
 ProcessedRecord truth_rows(const ClosedLoopResult& r, Eigen::Index first, Eigen::Index m,
                            double ts) {
@@ -77,21 +115,43 @@ ProcessedRecord truth_rows(const ClosedLoopResult& r, Eigen::Index first, Eigen:
   return p;
 }
 
+// Run A identified with the differential model (identify's defaults, the logged torque held for
+// one step) and the torque-prediction error [%] on run B of any base-parameter estimate (−1 for
+// none or a non-finite one); the constructor prints the differential model's and the truth's.
+class PredictionOnB {
+ public:
+  PredictionOnB(const Model& model, const ClosedLoopResult& ra, const ClosedLoopResult& rb,
+                double ts)
+      : model_(model), a_{ra.t, ra.q, {}, {}, ra.tau}, b_{rb.t, rb.q, {}, {}, rb.tau} {
+    def_.signal.torque_time_offset = 0.5 * ts;
+    diff_ = identify(model, a_, def_);
+    std::printf("differential %.2f %%, truth %.3f %%\n", (*this)(diff_.estimate.x),
+                (*this)(base().reduce(def_.layout.parameters(model))));
+  }
+  double operator()(const Eigen::VectorXd& x) const {
+    if (x.size() == 0 || !x.allFinite()) return -1.0;
+    return 100 * validate_torques(model_, b_, base().names, x, def_).relative_error_all;
+  }
+  const IdentifyOptions& options() const { return def_; }
+  const BaseParameters& base() const { return diff_.base; }
+  const JointRecord& a() const { return a_; }
+
+ private:
+  const Model& model_;
+  JointRecord a_, b_;
+  IdentifyOptions def_;
+  IdentificationResult diff_;
+};
+
 // Third study: the velocity of the kinetic-energy columns at the interval ends from a local
 // quadratic fit of the processed positions (IntegralOptions::endpoint_window), over cut-offs and
 // intervals; torque-prediction error on run B.
 int endpoint_window_study(const Model& model, const ClosedLoopResult& ra,
                           const ClosedLoopResult& rb, double ts) {
-  const JointRecord a{ra.t, ra.q, {}, {}, ra.tau}, b{rb.t, rb.q, {}, {}, rb.tau};
-  IdentifyOptions def;
-  def.signal.torque_time_offset = 0.5 * ts;
-  const IdentificationResult diff = identify(model, a, def);
-  const BaseParameters& base = diff.base;
-  auto err_b = [&](const Eigen::VectorXd& x) {
-    return 100 * validate_torques(model, b, base.names, x, def).relative_error_all;
-  };
-  std::printf("differential %.2f %%, truth %.3f %%\n", err_b(diff.estimate.x),
-              err_b(base.reduce(def.layout.parameters(model))));
+  const PredictionOnB err_b(model, ra, rb, ts);
+  const IdentifyOptions& def = err_b.options();
+  const BaseParameters& base = err_b.base();
+  const JointRecord& a = err_b.a();
   std::printf("cutoff interval | endpoint window [ms]: 0 5 10 25 50 100\n");
   for (double cutoff : {5.0, 10.0, 20.0, 40.0}) {
     SignalOptions so = def.signal;
@@ -114,10 +174,14 @@ int endpoint_window_study(const Model& model, const ClosedLoopResult& ra,
   return 0;
 }
 
+// The errors-in-variables treatments on the TX40 run (below).
+int eiv_tx40(const integral_testing::Tx40Run& run, const BaseParameters& base);
+
 // The same grid on the real TX40 run: joint friction values within 10 % of the published ones
 // (of 12), the largest friction error, the torque validation on the run and the energy
 // equations' relative error; for the defaults, every friction value with its 99.9 % interval.
-int tx40_study(const std::string& source_dir) {
+// With `eiv`, the errors-in-variables treatments instead (eiv_tx40).
+int tx40_study(const std::string& source_dir, bool eiv) {
   const integral_testing::Tx40Run run = integral_testing::load_tx40(source_dir);
   if (!run.found) {
     std::printf("TX40 data set not found\n");
@@ -126,6 +190,7 @@ int tx40_study(const std::string& source_dir) {
   const Model& model = run.model;
   IdentifyOptions def;
   const BaseParameters base = integral_testing::base_of(model, def.layout, true);
+  if (eiv) return eiv_tx40(run, base);
   const IdentificationResult diff = identify(model, run.record);
   std::printf(
       "differential: torque %.2f %%\n",
@@ -162,10 +227,7 @@ int tx40_study(const std::string& source_dir) {
   }
   std::printf("cutoff interval window | within10 maxerr%% torque%% energy%%\n");
   for (double cutoff : {10.0, 20.0, 40.0}) {
-    SignalOptions so = integral_signal_options();
-    so.cutoff_hz = cutoff;
-    std::vector<std::pair<std::string, std::string>> choices;
-    const ProcessedRecord p = preprocess(run.record, so, choices);
+    const ProcessedRecord p = processed_at(run.record, cutoff);
     for (double interval_ms : {10.0, 50.0}) {
       for (double window_ms : {0.0, 10.0, 25.0, 50.0, 100.0}) {
         IntegralOptions io;
@@ -173,22 +235,16 @@ int tx40_study(const std::string& source_dir) {
         io.endpoint_window = 1e-3 * window_ms;
         const Estimate e = integral_testing::estimate_with_intervals(
             integral_equations(model, def.layout, true, p, io), base);
-        int within = 0;
-        double worst = 0.0;
+        const auto [within, worst] = tx40_friction_score(run, base, e.x);
         const bool detail = cutoff == 10.0 && interval_ms == 10.0;
-        for (int j = 0; j < 6; ++j) {
+        for (int j = 0; j < 6 && detail; ++j) {
           for (const char* kind : {"v", "c"}) {
             const std::string name = std::string("F") + kind + std::to_string(j + 1);
             const double truth = run.published[kind[0] == 'v' ? "fv" : "fs"][j].as<double>();
             const Eigen::Index i = index(name);
-            const double err = std::abs(e.x[i] - truth) / truth;
-            within += err <= 0.1;
-            worst = std::max(worst, err);
-            if (detail) {
-              std::printf("    %s %.3f [%.3f, %.3f] published %.3f%s\n", name.c_str(), e.x[i],
-                          e.ci_lower[i], e.ci_upper[i], truth,
-                          truth >= e.ci_lower[i] && truth <= e.ci_upper[i] ? "" : "  OUTSIDE");
-            }
+            std::printf("    %s %.3f [%.3f, %.3f] published %.3f%s\n", name.c_str(), e.x[i],
+                        e.ci_lower[i], e.ci_upper[i], truth,
+                        truth >= e.ci_lower[i] && truth <= e.ci_upper[i] ? "" : "  OUTSIDE");
           }
         }
         const double torque =
@@ -411,10 +467,7 @@ EivEstimates eiv_estimates(const Model& model, const ParameterLayout& layout, bo
 // errors-in-variables treatments; torque-prediction error on run B.
 int eiv_study(double tf) {
   g_derivative_filter = tf;
-  Model model = load_robot("puma560");
-  for (int j = 0; j < model.dof(); ++j) {
-    model.joints[j].friction = {0.05 * (j + 1), 0.5 + 0.1 * j, 0.3 + 0.1 * j, 0.1 * (j + 1)};
-  }
+  const Model model = puma_with_friction();
   const double ts = 1e-3;
   const int n = model.dof();
   const ClosedLoopResult ra = run(model, 1, ts), rb = run(model, 2, ts);
@@ -434,17 +487,10 @@ int eiv_study(double tf) {
         (d.colwise().squaredNorm() / d.rows()).cwiseSqrt().maxCoeff(),
         std::sqrt(dv.squaredNorm() / dv.size()));
   }
-  const JointRecord a{ra.t, ra.q, {}, {}, ra.tau}, b{rb.t, rb.q, {}, {}, rb.tau};
-  IdentifyOptions def;
-  def.signal.torque_time_offset = 0.5 * ts;
-  const IdentificationResult diff = identify(model, a, def);
-  const BaseParameters& base = diff.base;
-  auto err_b = [&](const Eigen::VectorXd& x) {
-    if (x.size() == 0 || !x.allFinite()) return -1.0;
-    return 100 * validate_torques(model, b, base.names, x, def).relative_error_all;
-  };
-  std::printf("differential %.2f %%, truth %.3f %%\n", err_b(diff.estimate.x),
-              err_b(base.reduce(def.layout.parameters(model))));
+  const PredictionOnB err_b(model, ra, rb, ts);
+  const IdentifyOptions& def = err_b.options();
+  const BaseParameters& base = err_b.base();
+  const JointRecord& a = err_b.a();
   const Reference ref = integral_testing::multisine(n, 10.0, ts, 1, 1.0);
   std::printf(
       "cutoff interval | OLS  window25  | BCLS  IV(lagged)  IV(reference) | rho(interval) "
@@ -500,33 +546,15 @@ int eiv_study(double tf) {
 
 // The same treatments on the TX40 run (no reference: OLS, BCLS, lagged IV): friction values
 // within 10 % of the published 12, the largest error, the torque validation.
-int eiv_tx40(const std::string& source_dir) {
-  const integral_testing::Tx40Run run = integral_testing::load_tx40(source_dir);
-  if (!run.found) {
-    std::printf("TX40 data set not found\n");
-    return 1;
-  }
+int eiv_tx40(const integral_testing::Tx40Run& run, const BaseParameters& base) {
   const Model& model = run.model;
-  IdentifyOptions def;
-  const BaseParameters base = integral_testing::base_of(model, def.layout, true);
+  const IdentifyOptions def;
   auto score = [&](const Eigen::VectorXd& x) {
     if (x.size() == 0 || !x.allFinite()) {
       std::printf("  —              ");
       return;
     }
-    int within = 0;
-    double worst = 0.0;
-    for (int j = 0; j < 6; ++j) {
-      for (const char* kind : {"v", "c"}) {
-        const std::string name = std::string("F") + kind + std::to_string(j + 1);
-        const double truth = run.published[kind[0] == 'v' ? "fv" : "fs"][j].as<double>();
-        const Eigen::Index i =
-            std::find(base.names.begin(), base.names.end(), name) - base.names.begin();
-        const double err = std::abs(x[i] - truth) / truth;
-        within += err <= 0.1;
-        worst = std::max(worst, err);
-      }
-    }
+    const auto [within, worst] = tx40_friction_score(run, base, x);
     std::printf("  %2d %6.1f %6.2f", within, 100 * worst,
                 100 * validate_torques(model, run.record, base.names, x, def).relative_error_all);
   };
@@ -536,8 +564,7 @@ int eiv_tx40(const std::string& source_dir) {
   for (double cutoff : {10.0, 20.0, 40.0}) {
     SignalOptions so = integral_signal_options();
     so.cutoff_hz = cutoff;
-    std::vector<std::pair<std::string, std::string>> choices;
-    const ProcessedRecord p = preprocess(run.record, so, choices);
+    const ProcessedRecord p = processed_at(run.record, cutoff);
     for (double interval_ms : {10.0, 50.0}) {
       IntegralOptions io;
       io.interval = 1e-3 * interval_ms;
@@ -557,8 +584,10 @@ int eiv_tx40(const std::string& source_dir) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc > 1 && std::string(argv[1]) == "tx40") return tx40_study(argc > 2 ? argv[2] : ".");
-  if (argc > 1 && std::string(argv[1]) == "eiv-tx40") return eiv_tx40(argc > 2 ? argv[2] : ".");
+  if (argc > 1 && std::string(argv[1]) == "tx40")
+    return tx40_study(argc > 2 ? argv[2] : ".", false);
+  if (argc > 1 && std::string(argv[1]) == "eiv-tx40")
+    return tx40_study(argc > 2 ? argv[2] : ".", true);
   if (argc > 1 && std::string(argv[1]) == "eiv") {
     g_after = argc > 3 && std::atoi(argv[3]) != 0;
     if (argc > 4) g_noise_seed = static_cast<unsigned>(std::atoi(argv[4]));
@@ -566,19 +595,13 @@ int main(int argc, char** argv) {
   }
   if (argc > 1 && std::string(argv[1]) == "window") {
     g_after = argc > 2 && std::atoi(argv[2]) != 0;
-    Model model = load_robot("puma560");
-    for (int j = 0; j < model.dof(); ++j) {
-      model.joints[j].friction = {0.05 * (j + 1), 0.5 + 0.1 * j, 0.3 + 0.1 * j, 0.1 * (j + 1)};
-    }
+    const Model model = puma_with_friction();
     return endpoint_window_study(model, run(model, 1, 1e-3), run(model, 2, 1e-3), 1e-3);
   }
   if (argc > 1) g_noise = std::atof(argv[1]);
   if (argc > 2) g_torque_noise = std::atof(argv[2]);
   if (argc > 3) g_after = std::atoi(argv[3]) != 0;
-  Model model = load_robot("puma560");
-  for (int j = 0; j < model.dof(); ++j) {
-    model.joints[j].friction = {0.05 * (j + 1), 0.5 + 0.1 * j, 0.3 + 0.1 * j, 0.1 * (j + 1)};
-  }
+  const Model model = puma_with_friction();
   const double ts = 1e-3;
   const ClosedLoopResult ra = run(model, 1, ts), rb = run(model, 2, ts);
   const JointRecord a{ra.t, ra.q, {}, {}, ra.tau}, b{rb.t, rb.q, {}, {}, rb.tau};
