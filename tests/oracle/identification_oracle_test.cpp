@@ -1,5 +1,6 @@
 // End-to-end identification on data whose torques come from KDL's RNE (another implementation),
 // not from dynid's regressor: noise-free recovery, and confidence-interval coverage with noise.
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <random>
@@ -204,9 +205,14 @@ TEST(IdentificationOracle, ResidualAutocorrelationIsMeasuredAndWarned) {
 // Issue 11 item 3: "on a KDL-simulated 6-joint run where every joint moves, identify warns rank
 // 60 < 61 and reports YY1R with σ = null". Every joint of the puma560 (58 base parameters) and of
 // the TX40 (61 with its coupled wrist) moves (multi-sine), KDL's torques with and without noise,
-// velocities and accelerations derived from the sampled q as a user's log gives them: every base
-// parameter is data-identifiable and has a finite σ. (A guard only: these runs give full rank
-// with or without estimate_block's unit-norm re-solve; the reported run was not reproduced.)
+// velocities and accelerations derived from the sampled q as a user's log gives them.
+// Differential model: every base parameter is data-identifiable and has a finite σ (a guard: these
+// runs give full rank with or without estimate_block's unit-norm re-solve). Integral model, the
+// issue's own: on these runs its column-scaled energy equations have one (puma560, Fo6) or two
+// (TX40, Fvm6 and Fcm6) directions at 3–6e-7 of the largest singular value (differential: 2.3e-3
+// on the same data), below data_identifiability's 1e-6, so data rank 57 of 58 and 59 of 61; the
+// contract item 3 asks for still holds: those are named not excited with a warning, every
+// estimate has a finite σ, none is reported with σ = null (docs/methods/estimation.md §7).
 class SixJointKdl : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(SixJointKdl, RunWhereEveryJointMovesHasFullDataRank) {
@@ -222,17 +228,35 @@ TEST_P(SixJointKdl, RunWhereEveryJointMovesHasFullDataRank) {
     JointRecord run = r;
     run.tau = exact;
     for (Eigen::Index i = 0; i < run.tau.size(); ++i) run.tau.data()[i] += sigma * noise(rng);
-    const IdentificationResult res = identify(model, run, IdentifyOptions());
-    std::cout << name << " torque noise " << sigma << ": data rank " << res.data_rank << " of "
-              << res.rank << "\n";
-    EXPECT_EQ(res.data_rank, res.rank) << "torque noise " << sigma;
-    EXPECT_TRUE(res.not_excited.empty());
-    ASSERT_EQ(res.estimate.std_dev.size(), res.rank);
-    for (int i = 0; i < res.rank; ++i) {
-      EXPECT_TRUE(std::isfinite(res.estimate.std_dev[i]) && res.estimate.std_dev[i] > 0.0)
-          << res.names[i] << " σ = " << res.estimate.std_dev[i];
+    for (const IdentificationModel kind :
+         {IdentificationModel::kDifferential, IdentificationModel::kIntegral}) {
+      IdentifyOptions o;
+      o.model = kind;
+      const bool integral = kind == IdentificationModel::kIntegral;
+      const char* label = integral ? "integral" : "differential";
+      const IdentificationResult res = identify(model, run, o);
+      std::cout << name << " " << label << " model, torque noise " << sigma << ": data rank "
+                << res.data_rank << " of " << res.rank << "\n";
+      if (!integral) {
+        EXPECT_EQ(res.data_rank, res.rank) << "torque noise " << sigma;
+        for (const auto& w : res.warnings) EXPECT_EQ(w.find("rank"), std::string::npos) << w;
+      } else {
+        EXPECT_GE(res.data_rank, res.rank - 2) << "torque noise " << sigma;
+      }
+      EXPECT_EQ(res.not_excited.size(), static_cast<size_t>(res.rank - res.data_rank)) << label;
+      ASSERT_EQ(res.estimate.std_dev.size(), res.data_rank) << label;
+      for (int i = 0; i < res.data_rank; ++i) {
+        EXPECT_TRUE(std::isfinite(res.estimate.std_dev[i]) && res.estimate.std_dev[i] > 0.0)
+            << label << ": " << res.names[i] << " σ = " << res.estimate.std_dev[i];
+      }
+      for (const std::string& missing : res.not_excited) {
+        bool named = false;
+        for (const auto& w : res.warnings) named |= w.find(missing + " is not excited") == 0;
+        EXPECT_TRUE(named) << label << ": " << missing << " not excited without a warning";
+        EXPECT_EQ(std::find(res.names.begin(), res.names.end(), missing), res.names.end())
+            << label << ": " << missing << " is not excited but reported as an estimate";
+      }
     }
-    for (const auto& w : res.warnings) EXPECT_EQ(w.find("rank"), std::string::npos) << w;
   }
 }
 
