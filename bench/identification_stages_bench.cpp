@@ -1,14 +1,16 @@
-// Where the CPU time of streaming identification goes (issue 16 item 3; perf is not available on
-// the project machine): the per-sample stages of `dynid identify --stream` for the 7-DoF iiwa14,
-// full layout (98 columns, 69 base), each timed alone on the same 4096 samples (one chunk):
+// Where the CPU time of streaming identification goes (issue 16 item 3; `perf record -e cpu-clock`
+// on the whole `dynid identify --stream` gives the shares, docs/performance.md): the per-sample
+// stages of `dynid identify --stream` for the 7-DoF iiwa14, full layout (98 columns, 69 base), each
+// timed alone on the same 4096 samples (one chunk):
 //   CsvCut        CsvChunkReader::next_text on the file of those samples (the reader thread's
 //                 share: open, read, split lines; the reader is built per iteration, so its
 //                 buffers' page faults are counted once per 4096 samples instead of once per run)
-//   CsvParse      CsvChunkReader::parse_text of the 29-column text (t, q, dq, ddq, tau): the
-//                 workers' share
+//   CsvParse      CsvChunkReader::parse_text of the 29-column text (t, q, dq, ddq, tau) into a
+//                 row-major block, as the workers do
 //   Regressor     torque_regressor, one call per sample
-//   Accumulate    per joint: gather its base columns, StreamingLeastSquares::add_row with the
-//                 normal-equation accumulation and per-joint column subsets (as identify_stream)
+//   Accumulate    per joint: StreamingLeastSquares::add_row_gathered of its base columns out of
+//                 the regressor's storage, normal equations, per-joint column subsets (as
+//                 identify_stream, without its structural-zero check)
 // Figures are per chunk; divide by 4096 for the cost per sample.
 // Run: ./build/bench/identification_stages_bench --benchmark_repetitions=3
 //      --benchmark_report_aggregates_only=true
@@ -103,7 +105,7 @@ void BM_StageCsvParse(benchmark::State& st) {
   dynid::CsvChunkReader reader(r.csv);
   dynid::CsvTextChunk chunk;
   reader.next_text(chunk);  // the whole file is one chunk
-  Eigen::MatrixXd block;
+  dynid::CsvChunkReader::RowBlock block;
   for (auto _ : st) {
     reader.parse_text(chunk, block);
     benchmark::DoNotOptimize(block.data());
@@ -142,14 +144,12 @@ void BM_StageAccumulate(benchmark::State& st) {
   o.accumulation = dynid::Accumulation::kNormalEquations;
   o.group_columns = r.joint_columns;
   dynid::StreamingLeastSquares lsq(r.base.rank, n, o);
-  Eigen::VectorXd w(r.base.rank);
+  std::vector<std::vector<Eigen::Index>> offsets(n);  // entry (j, c) of Y at c·n + j
+  for (int j = 0; j < n; ++j)
+    for (Eigen::Index c : r.joint_columns[j]) offsets[j].push_back(r.base.base[c] * n + j);
   for (auto _ : st) {
     for (int k = 0; k < kSamples; ++k) {
-      for (int j = 0; j < n; ++j) {
-        const auto& cols = r.joint_columns[j];
-        for (std::size_t c = 0; c < cols.size(); ++c) w[c] = Ys[k](j, r.base.base[cols[c]]);
-        lsq.add_row(j, w.head(static_cast<Eigen::Index>(cols.size())), r.tau(j, k));
-      }
+      for (int j = 0; j < n; ++j) lsq.add_row_gathered(j, Ys[k].data(), offsets[j], r.tau(j, k));
     }
   }
   st.counters["ns_per_sample"] = benchmark::Counter(

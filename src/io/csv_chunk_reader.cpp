@@ -177,19 +177,29 @@ bool CsvChunkReader::next_text(CsvTextChunk& chunk) {
   return chunk.rows() > 0;
 }
 
-void CsvChunkReader::parse_text(const CsvTextChunk& chunk, Eigen::MatrixXd& block) const {
+void CsvChunkReader::parse_into(const CsvTextChunk& chunk, double* out, Eigen::Index row_step,
+                                Eigen::Index column_step) const {
   const Impl& s = *impl_;
   const Eigen::Index rows = chunk.rows();
-  block.resize(rows, static_cast<Eigen::Index>(s.columns.size()));
   const char* text = chunk.text.data();
   for (Eigen::Index k = 0; k < rows; ++k) {
     const std::size_t begin = k == 0 ? 0 : chunk.ends[static_cast<std::size_t>(k - 1)];
     const std::size_t end = chunk.ends[static_cast<std::size_t>(k)];
-    csv_detail::parse_row(text + begin, text + end, s.columns, block.data() + k, rows, s.source,
-                          chunk.lines[static_cast<std::size_t>(k)],
+    csv_detail::parse_row(text + begin, text + end, s.columns, out + k * row_step, column_step,
+                          s.source, chunk.lines[static_cast<std::size_t>(k)],
                           static_cast<long>(chunk.first_row + k) + 1,
                           chunk.unterminated && k + 1 == rows);
   }
+}
+
+void CsvChunkReader::parse_text(const CsvTextChunk& chunk, Eigen::MatrixXd& block) const {
+  block.resize(chunk.rows(), static_cast<Eigen::Index>(impl_->columns.size()));
+  parse_into(chunk, block.data(), 1, block.rows());
+}
+
+void CsvChunkReader::parse_text(const CsvTextChunk& chunk, RowBlock& block) const {
+  block.resize(chunk.rows(), static_cast<Eigen::Index>(impl_->columns.size()));
+  parse_into(chunk, block.data(), block.cols(), 1);
 }
 
 void for_each_csv_chunk(

@@ -141,17 +141,20 @@ void parse_row(const char* b, const char* e, const std::vector<std::string>& col
                 "; give every row one value per column");
   };
   const char* p = b;
-  for (std::size_t c = 0; c < n; ++c) {
+  std::size_t c = 0;
+  const char* field = p;
+  // Built once per row, not per field (its captures were stored on every iteration).
+  auto not_a_number = [&]() {
+    truncated();
+    const std::string text = field_text(field, e);
+    throw Error(
+        where(source, line) + "column '" + columns[c] + "' (field " + std::to_string(c + 1) +
+        "): " + (text.empty() ? std::string("empty field") : "'" + text + "' is not a number") +
+        "; write one decimal number per field (e.g. 0.5 or -1.2e-3)");
+  };
+  for (; c < n; ++c) {
     p = skip_spaces(p, e);
-    const char* field = p;
-    auto not_a_number = [&]() {
-      truncated();
-      const std::string text = field_text(field, e);
-      throw Error(
-          where(source, line) + "column '" + columns[c] + "' (field " + std::to_string(c + 1) +
-          "): " + (text.empty() ? std::string("empty field") : "'" + text + "' is not a number") +
-          "; write one decimal number per field (e.g. 0.5 or -1.2e-3)");
-    };
+    field = p;
     double v = 0.0;
     const char* end = parse_number(p, e, v);
     if (end == nullptr) {

@@ -1,5 +1,6 @@
 #include "dynid/regressor/torque_regressor.hpp"
 
+#include <algorithm>
 #include <cassert>
 
 #include "dynamics/joint_pose.hpp"
@@ -36,9 +37,15 @@ void torque_regressor(const Model& model, Workspace& ws, const ParameterLayout& 
   const int n = model.dof();
   assert(Y.rows() == n && Y.cols() == layout.columns(n));
   detail::local_kinematics(model, ws, q, dq, ddq, true);
-  Y.setZero();
   double* const y = Y.data();
   const Eigen::Index ld = Y.outerStride();
+  // A contiguous Y is cleared by one fill: Eigen's setZero on a Ref clears it column by column
+  // (a 56-byte memset call per column for 7 joints: 7 % of a streaming identification's CPU time).
+  if (ld == n) {
+    std::fill(y, y + n * Y.cols(), 0.0);
+  } else {
+    Y.setZero();
+  }
   detail::WrenchBlocks b;
   for (int j = 0; j < n; ++j) {
     const LinkState& s = ws.links[j];

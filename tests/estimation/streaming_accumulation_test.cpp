@@ -1,12 +1,17 @@
 // Normal-equation accumulation, per-group column subsets and merging of StreamingLeastSquares,
 // checked against the Householder accumulation of all columns and against an in-memory QR oracle.
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <Eigen/QR>
 
 #include "dynid/estimation/streaming_least_squares.hpp"
 #include "estimation/estimation_support.hpp"
+#include "estimation/gram_update.hpp"
 
 namespace dynid {
 namespace {
@@ -96,18 +101,71 @@ TEST(StreamingAccumulation, MergeEqualsOneAccumulatorAndRowByRowEqualsBlocks) {
     b.add(s.W.bottomRows(s.W.rows() - half), s.y.tail(s.W.rows() - half),
           s.groups.tail(s.W.rows() - half));
     a.merge(b);
-    for (Eigen::Index r = 0; r < s.W.rows(); ++r) {
+    // add_row_gathered reads the row out of W's storage (column-major: entry (r, c) at c·m + r).
+    StreamingLeastSquares gathered(9, 3, o);
+    const Eigen::Index m = s.W.rows();
+    for (Eigen::Index r = 0; r < m; ++r) {
       const int g = s.groups(r);
       Eigen::VectorXd w(s.columns[g].size());
-      for (std::size_t c = 0; c < s.columns[g].size(); ++c) w(c) = s.W(r, s.columns[g][c]);
+      std::vector<Eigen::Index> offsets;
+      for (std::size_t c = 0; c < s.columns[g].size(); ++c) {
+        w(c) = s.W(r, s.columns[g][c]);
+        offsets.push_back(s.columns[g][c] * m + r);
+      }
       rows.add_row(g, w, s.y(r));
+      gathered.add_row_gathered(g, s.W.data(), offsets, s.y(r));
+      if (r == 7) {  // a refused row leaves no trace
+        const double bad[1] = {std::nan("")};
+        const std::vector<Eigen::Index> zeros(s.columns[g].size(), 0);
+        expect_error([&] { gathered.add_row_gathered(g, bad, zeros, 1.0); }, {"NaN or Inf"});
+      }
     }
     const Estimate e1 = one.solve_weighted();
     EXPECT_EQ(a.rows(), one.rows());
     EXPECT_EQ(a.group_rows(), one.group_rows());
+    EXPECT_EQ(gathered.group_rows(), one.group_rows());
     EXPECT_LT(rel(a.solve_weighted().x, e1.x), 1e-11);
     EXPECT_LT(rel(rows.solve_weighted().x, e1.x), 1e-11);
+    EXPECT_LT(rel(gathered.solve_weighted().x, e1.x), 1e-11);
+    EXPECT_LT(rel(gathered.factor().transpose() * gathered.factor(),
+                  rows.factor().transpose() * rows.factor()),
+              1e-12);
     EXPECT_LT(rel(a.solve_weighted().std_dev, e1.std_dev), 1e-10);
+  }
+}
+
+// The blocked Gram kernel against sums in long double, for sizes around its 8×4 tiles and
+// 64-column panels; entries below the diagonal are left alone.
+TEST(StreamingAccumulation, GramKernelEqualsLongDoubleSums) {
+  std::mt19937 rng(36);
+  for (const Eigen::Index q : {1, 3, 4, 5, 8, 9, 13, 31, 70, 71}) {
+    for (const Eigen::Index k : {1, 7, 64, 65, 256}) {
+      const Eigen::Index ldb = estimation_detail::gram_padded_rows(q);
+      Eigen::MatrixXd B = Eigen::MatrixXd::Zero(ldb, k);
+      B.topRows(q) = gaussian(q, k, rng);
+      Eigen::MatrixXd G = gaussian(q, q, rng);
+      const Eigen::MatrixXd G0 = G;
+      estimation_detail::gram_update_upper(q, k, B.data(), ldb, G.data());
+      double worst = 0.0;
+      for (Eigen::Index j = 0; j < q; ++j) {
+        for (Eigen::Index i = 0; i < q; ++i) {
+          if (i > j) {
+            ASSERT_EQ(G(i, j), G0(i, j)) << "lower entry (" << i << ", " << j << ") written";
+            continue;
+          }
+          long double sum = G0(i, j), scale = std::abs(G0(i, j));
+          for (Eigen::Index s = 0; s < k; ++s) {
+            sum += static_cast<long double>(B(i, s)) * B(j, s);
+            scale += std::abs(B(i, s) * B(j, s));
+          }
+          worst = std::max(worst, static_cast<double>(std::abs(G(i, j) - sum) / scale));
+        }
+      }
+      // Higham's bound for a sum of k + 1 terms in any order: γ_{k+1} ≈ (k + 1)·u of Σ|terms|;
+      // a wrong index or a missed tile is off by O(1).
+      EXPECT_LT(worst, (k + 1) * std::numeric_limits<double>::epsilon() / 2)
+          << "q = " << q << ", k = " << k;
+    }
   }
 }
 
@@ -149,6 +207,13 @@ TEST(StreamingAccumulation, BadColumnListsAndRowsGiveClearErrors) {
                {"w has 2 entries", "group 1 has 1 columns"});
   expect_error([&] { s.add_row(2, Eigen::VectorXd::Ones(1), 0.0); }, {"group 2 is outside"});
   expect_error([&] { s.add_row(1, Eigen::VectorXd::Ones(1), std::nan("")); }, {"NaN or Inf"});
+  const double row[2] = {1.0, 2.0};
+  expect_error(
+      [&] {
+        s.add_row_gathered(1, row, {0, 1}, 0.0);
+      },
+      {"2 offsets", "group 1 has 1 columns"});
+  expect_error([&] { s.add_row_gathered(-1, row, {0}, 0.0); }, {"group -1 is outside"});
   StreamingLeastSquares other(3, 2);
   expect_error([&] { s.merge(other); }, {"merge: group 0 keeps different columns"});
   StreamingOptions ne;

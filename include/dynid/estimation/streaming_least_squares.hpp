@@ -73,6 +73,13 @@ class StreamingLeastSquares {
   /// size, or NaN/Inf (naming the stream row).
   void add_row(int group, const Eigen::Ref<const Eigen::VectorXd>& w, double y);
 
+  /// add_row with the row's p_g entries read as source[offsets[0]], source[offsets[1]], ... (its
+  /// group_columns, in order) straight into the pending block: no intermediate vector when the row
+  /// is gathered from a larger buffer (identify_stream reads a joint's base columns out of the
+  /// regressor's storage). Same errors as add_row (offsets must have p_g entries).
+  void add_row_gathered(int group, const double* source, const std::vector<Eigen::Index>& offsets,
+                        double y);
+
   /// Adds the rows accumulated by `other` (same parameters, groups and options), as if they had
   /// been added here. Throws dynid::Error on a mismatch.
   void merge(const StreamingLeastSquares& other);
@@ -108,6 +115,8 @@ class StreamingLeastSquares {
   struct Group {
     std::vector<Eigen::Index> columns;  // the p_g columns kept, then p (the y column)
     Eigen::MatrixXd summary;  // (p_g+1)²: factor R_g or upper triangle of the Gram matrix
+    Eigen::MatrixXd partial;  // normal equations: Gram of the folds not yet added to summary
+    int partial_folds = 0;
     Eigen::MatrixXd pending;  // rows not yet folded in, one per column: (p_g+1) × kChunk
     Eigen::Index pending_rows = 0;
     Eigen::Index rows = 0;
@@ -117,6 +126,7 @@ class StreamingLeastSquares {
   void add_full_row(int group, const Eigen::Ref<const Eigen::MatrixXd>& W,
                     const Eigen::Ref<const Eigen::VectorXd>& y, Eigen::Index i);
   void fold(Group& g) const;
+  void drain(Group& g) const;  // adds partial to summary (normal equations)
   // κ of the column-equilibrated [W y] with rows of group g scaled by weights(g) (NE mode).
   double normal_equations_condition(const Eigen::VectorXd& weights) const;
   void flush() const;

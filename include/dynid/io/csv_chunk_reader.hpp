@@ -62,10 +62,19 @@ class CsvChunkReader {
   /// header, so other threads may call it while next_text cuts the following chunks.
   void parse_text(const CsvTextChunk& chunk, Eigen::MatrixXd& block) const;
 
+  /// Row-major block (chunk.rows() × columns().size()), sample k's fields contiguous: parse_text
+  /// for a consumer that reads a whole sample at a time (identify_stream); the parse writes and
+  /// the consumer reads memory in order instead of one cache line per column. Same errors.
+  using RowBlock = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  void parse_text(const CsvTextChunk& chunk, RowBlock& block) const;
+
   /// Number of data rows yielded so far.
   Eigen::Index rows_read() const;
 
  private:
+  // Parses chunk row k, field c into out[k·row_step + c·column_step].
+  void parse_into(const CsvTextChunk& chunk, double* out, Eigen::Index row_step,
+                  Eigen::Index column_step) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
