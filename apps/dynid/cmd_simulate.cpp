@@ -81,7 +81,8 @@ void run(const SimulateCliOptions& o) {
   s.feed_forward = o.controller == "pid"               ? FeedForward::kNone
                    : o.controller == "computed-torque" ? FeedForward::kInverseDynamics
                                                        : FeedForward::kComputedTorque;
-  if (!o.params.empty()) s.controller_model = model_from_result(model, o.params);
+  if (!o.params.empty())
+    s.controller_model = completed_model_from_result(model, o.params, "simulate").model;
   if (!o.gains.empty()) s.gains = read_pid_gains(o.gains, model);
   s.plant.engine = o.engine == "mujoco" ? PlantEngine::kMujoco : PlantEngine::kNative;
   s.sensors.position_noise_std = o.position_noise;
