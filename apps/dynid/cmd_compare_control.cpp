@@ -63,7 +63,9 @@ void add_compare_control_command(CLI::App& app) {
   cmd->add_option("--robot,-r", o->robot, "Built-in robot name or .urdf/.yaml model (the plant)")
       ->required();
   cmd->add_option("--params,-p", o->params,
-                  "result.json of dynid identify: the model of the computed-torque controller")
+                  "result.json of dynid identify: the model of the computed-torque controller; "
+                  "parameters its data did not determine take the --robot model's values "
+                  "(parameter_sources in --json)")
       ->required();
   cmd->add_option("--trajectory,-t", o->trajectory,
                   "Reference CSV with t and q* (dq*, ddq* optional), one period")
