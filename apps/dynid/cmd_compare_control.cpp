@@ -32,7 +32,7 @@ void run(const CompareControlCliOptions& o) {
   }
   if (!(o.reversal_window >= 0.0)) throw UsageError("--reversal-window must be >= 0 [s]");
   const Model model = load_robot(o.robot);
-  const Model identified = model_from_result(model, o.params);
+  const CompletedModel identified = completed_model_from_result(model, o.params, "compare-control");
   const JointRecord ref = read_reference(o.trajectory, model);
   ControlComparisonOptions c;
   c.simulate.plant.engine = o.engine == "mujoco" ? PlantEngine::kMujoco : PlantEngine::kNative;
@@ -40,10 +40,12 @@ void run(const CompareControlCliOptions& o) {
   if (!o.gains.empty()) c.simulate.gains = read_pid_gains(o.gains, model);
   c.reversal_window = o.reversal_window;
   const ControlComparison result =
-      compare_control(model, identified, ref.t, ref.q, ref.dq, ref.ddq, c);
+      compare_control(model, identified.model, ref.t, ref.q, ref.dq, ref.ddq, c);
   std::cout << control_comparison_table(model, result);
   if (!o.json.empty()) {
-    write_json(o.json, control_comparison_to_json(model, result, o.reversal_window));
+    nlohmann::json out = control_comparison_to_json(model, result, o.reversal_window);
+    out["parameter_sources"] = parameter_sources_json(identified);
+    write_json(o.json, out);
     std::cout << "wrote " << o.json << '\n';
   }
 }
@@ -61,7 +63,9 @@ void add_compare_control_command(CLI::App& app) {
   cmd->add_option("--robot,-r", o->robot, "Built-in robot name or .urdf/.yaml model (the plant)")
       ->required();
   cmd->add_option("--params,-p", o->params,
-                  "result.json of dynid identify: the model of the computed-torque controller")
+                  "result.json of dynid identify: the model of the computed-torque controller; "
+                  "parameters its data did not determine take the --robot model's values "
+                  "(parameter_sources in --json)")
       ->required();
   cmd->add_option("--trajectory,-t", o->trajectory,
                   "Reference CSV with t and q* (dq*, ddq* optional), one period")

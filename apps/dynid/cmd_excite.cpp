@@ -13,6 +13,7 @@
 #include "dynid/common/progress.hpp"
 #include "dynid/excitation/bang_bang_trajectory.hpp"
 #include "dynid/excitation/fourier_trajectory.hpp"
+#include "dynid/excitation/joint_fourier.hpp"
 #include "dynid/excitation/polynomial_spline.hpp"
 #include "dynid/excitation/slope_trajectory.hpp"
 #include "dynid/excitation/trapezoidal_trajectory.hpp"
@@ -101,7 +102,23 @@ TrajectorySamples joint_experiment(const Model& model, const ExciteCliOptions& o
   };
   const Eigen::VectorXd same = Eigen::VectorXd::Constant(n, 1.0);
   std::unique_ptr<Trajectory> trajectory;
-  if (o.family == "spline") {
+  // What to change when a limit is exceeded, per family.
+  const std::string slower = o.family == "fourier"  ? "narrow --range or lower --f0/--harmonics"
+                             : o.family == "spline" ? "lengthen --duration"
+                                                    : "lower --velocity/--acceleration";
+  if (o.family == "fourier") {
+    if (o.range.empty()) {
+      throw UsageError("--family fourier --joint needs --range FROM:TO of joint " +
+                       std::to_string(o.joint) + " (e.g. --range -0.5:0.5)");
+    }
+    const auto [from, to] = parse_range(o.range);
+    JointFourierOptions fo;
+    fo.harmonics = o.harmonics;
+    fo.f0 = o.f0;
+    fo.rest_at_ends = !o.no_rest;
+    trajectory =
+        std::make_unique<FourierTrajectory>(joint_fourier_reference(pose, j, from, to, fo));
+  } else if (o.family == "spline") {
     if (o.via.size() < 2) {
       throw UsageError("--family spline needs --via with at least 2 positions of joint " +
                        std::to_string(o.joint) + " (e.g. --via 0,0.8,-0.4,0)");
@@ -160,14 +177,14 @@ TrajectorySamples joint_experiment(const Model& model, const ExciteCliOptions& o
     const double v = samples.dq.col(k).cwiseAbs().maxCoeff();
     if (v > v_lim) {
       throw UsageError(name + " reaches " + short_number(v) + " rad/s, above its limit " +
-                       short_number(v_lim) + "; lower --velocity or lengthen --duration");
+                       short_number(v_lim) + "; " + slower);
     }
     if (ddq_max.size()) {
       const double acc = samples.ddq.col(k).cwiseAbs().maxCoeff();
       if (acc > ddq_max[k]) {
         throw UsageError(name + " reaches " + short_number(acc) +
-                         " rad/s², above --acceleration-limit " + short_number(ddq_max[k]) +
-                         "; lower --acceleration or lengthen --duration");
+                         " rad/s², above --acceleration-limit " + short_number(ddq_max[k]) + "; " +
+                         slower);
       }
     }
   }
@@ -205,10 +222,19 @@ void run_excite(const ExciteCliOptions& o) {
     run_joint_experiment(o);
     return;
   }
-  if (o.joint != 0) {
-    throw UsageError(
-        "--joint with --family fourier (one joint at a time) is not available yet; omit --joint "
-        "to optimise every joint together");
+  if (o.harmonics < 2 && !o.no_rest) {
+    throw UsageError("--harmonics " + std::to_string(o.harmonics) +
+                     " leaves no free coefficient once the trajectory starts and ends at rest "
+                     "(dq = ddq = 0): use --harmonics 2 or more, or --no-rest");
+  }
+  if (o.harmonics < 1) throw UsageError("--harmonics must be >= 1");
+  if (!(o.f0 > 0.0)) throw UsageError("--f0 must be > 0 Hz");
+  if (o.joint != 0) {  // one joint, Schroeder phases scaled to --range (joint_fourier_reference)
+    if (!o.json.empty())
+      throw UsageError(
+          "--json is written by the optimised --family fourier only (without --joint)");
+    run_joint_experiment(o);
+    return;
   }
   if (o.criterion != "cond" && o.criterion != "logdet") {
     throw UsageError("--criterion must be cond or logdet, not '" + o.criterion + "'");
@@ -231,11 +257,6 @@ void run_excite(const ExciteCliOptions& o) {
   options.dq_max = limits(o.dq_max, model.dof(), "--velocity-limit");
   options.ddq_max = limits(o.ddq_max, model.dof(), "--acceleration-limit");
   options.tau_max = limits(o.tau_max, model.dof(), "--torque-limit");
-  if (o.harmonics < 2 && !o.no_rest) {
-    throw UsageError("--harmonics " + std::to_string(o.harmonics) +
-                     " leaves no free coefficient once the trajectory starts and ends at rest "
-                     "(dq = ddq = 0): use --harmonics 2 or more, or --no-rest");
-  }
   ProgressLine progress("excite", progress_wanted(o.quiet));
   options.progress = progress.callback();
   const ExcitationResult result = optimize_excitation(model, options);
@@ -257,7 +278,9 @@ void run_excite(const ExciteCliOptions& o) {
 void add_excite_command(CLI::App& app) {
   auto o = std::make_shared<ExciteCliOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "excite", "Optimise a finite-Fourier-series excitation (condition number or D-optimality)");
+      "excite",
+      "Optimise a finite-Fourier-series excitation (condition number or D-optimality), or write "
+      "a one-joint experiment reference (--family ... --joint J)");
   cmd->add_option("--robot,-r", o->robot, "Built-in robot name or .urdf/.yaml model")->required();
   cmd->add_option("--out,-o", o->out, "Trajectory CSV: t, q1..qn, dq1..dqn, ddq1..ddqn")
       ->required();
@@ -295,7 +318,8 @@ void add_excite_command(CLI::App& app) {
   cmd->add_flag("--no-rest", o->no_rest,
                 "Do not force zero velocity/acceleration at start and end");
   cmd->add_option("--family", o->family,
-                  "fourier (optimised, every joint), or a one-joint experiment reference: slope "
+                  "fourier (optimised, every joint; with --joint: joint J alone, Schroeder phases, "
+                  "amplitudes 1/k, scaled to --range), or a one-joint experiment reference: slope "
                   "(constant-velocity slopes, gravity), bang-bang (friction), trapezoid, spline")
       ->capture_default_str();
   cmd->add_option("--joint", o->joint, "The joint that moves (1..n); the others stay at --pose");
@@ -303,7 +327,8 @@ void add_excite_command(CLI::App& app) {
                   "Positions of the other joints [rad or m], n values; default 0 (or the middle "
                   "of a range that excludes 0)")
       ->delimiter(',');
-  cmd->add_option("--range", o->range, "slope, bang-bang, trapezoid: FROM:TO of the joint");
+  cmd->add_option("--range", o->range,
+                  "fourier --joint, slope, bang-bang, trapezoid: FROM:TO of the joint");
   cmd->add_option("--velocity", o->velocity, "slope, trapezoid: cruise speed [rad/s]");
   cmd->add_option("--acceleration", o->acceleration,
                   "slope, bang-bang, trapezoid: acceleration [rad/s²]");

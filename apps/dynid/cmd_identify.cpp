@@ -14,6 +14,7 @@
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
 #include "dynid/common/progress.hpp"
+#include "dynid/estimation/completed_model.hpp"
 #include "dynid/estimation/decoupled_model.hpp"
 #include "dynid/estimation/friction_experiment.hpp"
 #include "dynid/estimation/gravity_experiment.hpp"
@@ -375,18 +376,6 @@ struct FileOptions {
   }
 };
 
-// A result whose data left base parameters undetermined holds data regroupings, not a model:
-// used as a whole model it would simulate or compensate with wrong numbers.
-void refuse_undetermined(const IdentifiedResultFile& f, const std::string& path,
-                         const std::string& use) {
-  if (f.not_excited.empty()) return;
-  std::string list;
-  for (const std::string& name : f.not_excited) list += (list.empty() ? "" : ", ") + name;
-  throw Error("'" + path + "' does not determine " + list +
-              " (not_excited), so it is no complete model to " + use +
-              "; identify from runs that also excite them");
-}
-
 // A result identified with --friction-known stores that friction in options.known_friction: add
 // it back (names, values and layout), so that its predictions are full torques.
 void add_stored_known_friction(const IdentifiedResultFile& f, const std::string& path,
@@ -414,13 +403,36 @@ void add_stored_known_friction(const IdentifiedResultFile& f, const std::string&
   append_known_friction(known, names, values, options.layout);
 }
 
+// A result as a complete model (complete_identified_model): the parameters its data left
+// undetermined or badly determined take the nominal model's values, said on stderr.
+CompletedModel completed_result_model(const Model& model, const IdentifiedResultFile& f,
+                                      const std::string& path,
+                                      const std::vector<std::string>& names,
+                                      const Eigen::VectorXd& values, const IdentifyOptions& options,
+                                      const std::string& command) {
+  CompletedModel c = complete_identified_model(model, names, values, f.std_devs, f.not_excited,
+                                               f.data_regrouping, f.covariance, options);
+  for (const std::string& w : c.warnings) warn(command + ": '" + path + "': " + w);
+  return c;
+}
+
 // The model whose rigid-body and armature torques a friction experiment subtracts: the robot's
 // nominal one, or the one identified in `params` (its base parameters, the rest nominal).
 Model compensation_model(const Model& model, const std::string& params) {
-  if (params.empty()) return model;
+  return completed_model_from_result(model, params, "identify").model;
+}
+
+}  // namespace
+
+CompletedModel completed_model_from_result(const Model& model, const std::string& params,
+                                           const std::string& command) {
+  if (params.empty()) {
+    CompletedModel nominal;
+    nominal.model = model;
+    return nominal;
+  }
   const IdentifiedResultFile f = read_identification_result(params);
   require_same_robot(f.robot, model.name, "'" + params + "'", "give a result of this robot");
-  refuse_undetermined(f, params, "compensate a friction experiment with it");
   IdentifyCliOptions o;
   const FileOptions file_options{f.options, params};
   o.friction = file_options.get("friction", o.friction);
@@ -429,8 +441,17 @@ Model compensation_model(const Model& model, const std::string& params) {
   std::vector<std::string> names = f.names;
   Eigen::VectorXd values = f.values;
   add_stored_known_friction(f, params, model, names, values, options);
-  return identified_model(model, names, values, options);
+  return completed_result_model(model, f, params, names, values, options, command);
 }
+
+nlohmann::json parameter_sources_json(const CompletedModel& c) {
+  return {{"identified", c.identified},
+          {"nominal_not_excited", c.nominal_not_excited},
+          {"nominal_badly_determined", c.nominal_badly_determined},
+          {"max_shift_sigma", c.max_shift_sigma}};
+}
+
+namespace {
 
 // `identify --model gravity|friction|decoupled`: seed 2's dedicated experiments on one joint.
 void run_experiment(const IdentifyCliOptions& o, const IdentifyOptions& options,
@@ -780,7 +801,6 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
     const JointRecord ref = read_reference(v.trajectory, model, reference_file);
     PlantOptions plant;
     plant.engine = v.engine == "mujoco" ? PlantEngine::kMujoco : PlantEngine::kNative;
-    refuse_undetermined(identified, v.params, "simulate");
     // The run's own loop: --gains, else the gains file simulate wrote beside the run.
     PidGains gains;
     const std::string beside = gains_file_for_run(v.data);
@@ -803,15 +823,18 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
                                          : FeedForward::kComputedTorque;
     read.notes.push_back("controller " + controller);
     echo_choices("validate", read, {});
-    const SimulationValidation sv = validate_run_by_simulation(
-        identified_model(model, names, values, options), ref.t, ref.q, ref.dq, ref.ddq, record.q,
-        record.tau, plant, feed_forward, gains);
+    const CompletedModel completed =
+        completed_result_model(model, identified, v.params, names, values, options, "validate");
+    const SimulationValidation sv =
+        validate_run_by_simulation(completed.model, ref.t, ref.q, ref.dq, ref.ddq, record.q,
+                                   record.tau, plant, feed_forward, gains);
     std::cout << simulation_validation_table(model, sv);
     if (!v.histograms.empty()) {
       write_error_histograms(v.histograms, model, sv);
       std::cout << "wrote " << v.histograms << '\n';
     }
-    const nlohmann::json out = simulation_validation_to_json(model, sv);
+    nlohmann::json out = simulation_validation_to_json(model, sv);
+    out["parameter_sources"] = parameter_sources_json(completed);
     if (!v.json.empty()) {
       write_json(v.json, out);
       std::cout << "wrote " << v.json << '\n';
@@ -908,10 +931,6 @@ IdentifyOptions options_from_identification_result(const IdentifiedResultFile& i
   } catch (const UsageError& e) {
     throw file_option_error(e, path);
   }
-}
-
-Model model_from_result(const Model& model, const std::string& params) {
-  return compensation_model(model, params);
 }
 
 void add_identify_command(CLI::App& app) {

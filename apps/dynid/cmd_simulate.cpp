@@ -81,7 +81,8 @@ void run(const SimulateCliOptions& o) {
   s.feed_forward = o.controller == "pid"               ? FeedForward::kNone
                    : o.controller == "computed-torque" ? FeedForward::kInverseDynamics
                                                        : FeedForward::kComputedTorque;
-  if (!o.params.empty()) s.controller_model = model_from_result(model, o.params);
+  if (!o.params.empty())
+    s.controller_model = completed_model_from_result(model, o.params, "simulate").model;
   if (!o.gains.empty()) s.gains = read_pid_gains(o.gains, model);
   s.plant.engine = o.engine == "mujoco" ? PlantEngine::kMujoco : PlantEngine::kNative;
   s.sensors.position_noise_std = o.position_noise;
@@ -147,8 +148,10 @@ void add_simulate_command(CLI::App& app) {
                   "computed-torque law with the model identified in --params: mass matrix, "
                   "Coriolis, gravity and friction, the PID correcting the acceleration)")
       ->capture_default_str();
-  cmd->add_option("--params,-p", o->params,
-                  "With --controller computed-torque: result.json of dynid identify");
+  cmd->add_option(
+      "--params,-p", o->params,
+      "With --controller computed-torque: result.json of dynid identify; parameters its "
+      "data did not determine take the --robot model's values (a warning names them)");
   cmd->add_option("--gains", o->gains,
                   "YAML file with kp, ki, kd lists (one value per joint); default: a bandwidth "
                   "rule that accounts for --delay. The gains used are written to <out>.gains.json");

@@ -7,6 +7,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include <nlohmann/json.hpp>
+
+#include "dynid/estimation/completed_model.hpp"
 #include "dynid/model/model.hpp"
 
 namespace dynid::cli {
@@ -47,9 +50,16 @@ void add_payload_command(CLI::App& app);
 void add_compare_control_command(CLI::App& app);
 
 /// The model of identified base parameters in result JSON `params` (identified_model(), with the
-/// friction set and armature the file records), or `model` itself when params is empty. Throws
+/// friction set and armature the file records) completed where its data do not determine them
+/// (complete_identified_model(): nominal values; warnings on stderr, prefixed with `command`),
+/// with where each base parameter came from; with params empty the nominal model. Throws
 /// dynid::Error naming the file (unreadable, another robot, a name that is no base parameter).
-Model model_from_result(const Model& model, const std::string& params);
+CompletedModel completed_model_from_result(const Model& model, const std::string& params,
+                                           const std::string& command);
+
+/// `parameter_sources` of a JSON output: identified, nominal_not_excited,
+/// nominal_badly_determined, max_shift_sigma (CompletedModel).
+nlohmann::json parameter_sources_json(const CompletedModel& completed);
 
 /// `dynid export`: physically consistent parameters written as URDF (cmd_export.cpp).
 void add_export_command(CLI::App& app);

@@ -5,6 +5,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "dynid/common/error.hpp"
@@ -94,12 +95,22 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
       excitation["holds_from_t"] = r.excitation.holds_from_t;
     }
   }
+  // The covariance and the data regroupings let a later command fill undetermined parameters
+  // (complete_identified_model) without the data.
+  auto rows = [](const Eigen::MatrixXd& m) {
+    nlohmann::json out = nlohmann::json::array();
+    for (Eigen::Index i = 0; i < m.rows(); ++i) out.push_back(numbers(m.row(i).transpose()));
+    return out;
+  };
   return {{"model",
            {{"name", model.name},
             {"source", model.source},
             {"dof", model.dof()},
             {"joints", joint_names(model)}}},
           {"parameters", params},
+          {"covariance_matrix", rows(e.covariance)},
+          {"data_regrouping",
+           r.not_excited.empty() ? nlohmann::json::array() : rows(r.data_regrouping)},
           {"confidence_level", e.confidence_level},
           {"rank", r.rank},
           {"data_rank", r.data_rank},
@@ -167,6 +178,48 @@ std::string identification_table(const Model& model, const IdentificationResult&
   for (const auto& w : r.warnings) s << "warning: " << one_line(w) << '\n';
   return s.str();
 }
+
+namespace {
+// `std` per parameter, `covariance_matrix` and `data_regrouping` (optional: hand-written files
+// and files written before they were stored have none; numbers that do not fit are an error).
+void read_completion_data(const nlohmann::json& j, const std::string& path,
+                          IdentifiedResultFile& out) {
+  const auto n = static_cast<Eigen::Index>(out.names.size());
+  out.std_devs = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::quiet_NaN());
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto& p = j["parameters"][static_cast<size_t>(i)];
+    if (p.contains("std") && p["std"].is_number()) out.std_devs[i] = p["std"].get<double>();
+  }
+  auto matrix = [&](const char* key, Eigen::Index rows, Eigen::Index cols) {
+    const auto it = j.find(key);
+    if (it == j.end()) return Eigen::MatrixXd();
+    Eigen::MatrixXd m(rows, cols);
+    bool ok = it->is_array() && static_cast<Eigen::Index>(it->size()) == rows;
+    bool finite = true;  // null (an infinite σ) leaves the matrix out, not the file
+    for (Eigen::Index r = 0; ok && r < rows; ++r) {
+      const auto& row = (*it)[static_cast<size_t>(r)];
+      ok = row.is_array() && static_cast<Eigen::Index>(row.size()) == cols;
+      for (Eigen::Index c = 0; ok && c < cols; ++c) {
+        const auto& x = row[static_cast<size_t>(c)];
+        ok = x.is_number() || x.is_null();
+        finite = finite && x.is_number() && std::isfinite(x.get<double>());
+        if (finite) m(r, c) = x.get<double>();
+      }
+    }
+    if (ok && !finite) return Eigen::MatrixXd();
+    if (!ok) {
+      throw Error("'" + path + "': " + key + " must be " + std::to_string(rows) + " rows of " +
+                  std::to_string(cols) +
+                  " finite numbers; give the result.json of dynid "
+                  "identify unedited");
+    }
+    return m;
+  };
+  out.covariance = matrix("covariance_matrix", n, n);
+  const auto ne = static_cast<Eigen::Index>(out.not_excited.size());
+  if (ne > 0) out.data_regrouping = matrix("data_regrouping", n, ne);
+}
+}  // namespace
 
 IdentifiedResultFile read_identification_result(const std::string& path) {
   std::ifstream f(path);
@@ -246,6 +299,7 @@ IdentifiedResultFile identification_result_from_json(const nlohmann::json& j,
       out.not_excited.push_back(name.get<std::string>());
     }
   }
+  read_completion_data(j, path, out);
   const auto choices = j.find("choices");
   if (choices != j.end() && choices->is_object() && choices->contains("cutoff_hz")) {
     const auto& c = (*choices)["cutoff_hz"];

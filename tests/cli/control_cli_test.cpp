@@ -81,6 +81,9 @@ TEST_F(ControlCli, CompareControlWritesTheControllersContract) {
     EXPECT_LT(j["controllers"][1]["joints"][k]["max_at_reversal"].get<double>(),
               j["controllers"][0]["joints"][k]["max_at_reversal"].get<double>());
   EXPECT_NE(r.out.find("computed-torque"), std::string::npos) << r.out;
+  // A run of both joints determines every base parameter: nothing from the nominal model.
+  EXPECT_EQ(j["parameter_sources"]["nominal_not_excited"].size(), 0u);
+  EXPECT_GT(j["parameter_sources"]["identified"].size(), 0u);
 }
 
 TEST_F(ControlCli, SimulateComputedTorqueAndValidateReadTheGainsBesideTheRun) {
@@ -125,6 +128,17 @@ TEST_F(ControlCli, BadInputIsOneErrorLine) {
                            " --trajectory " + work("traj.csv"));
   EXPECT_EQ(missing.code, 1);
   EXPECT_EQ(testing::error_contract_problem(missing.err), "") << missing.err;
+  // A hand-edited covariance_matrix of the wrong size is blamed on the file (exit 1, no output).
+  nlohmann::json result = nlohmann::json::parse(std::ifstream(work("result.json")));
+  result["covariance_matrix"] = nlohmann::json::array({nlohmann::json::array({1.0})});
+  std::ofstream(work("edited.json")) << result.dump();
+  const auto edited =
+      run("compare-control --robot planar2 --params " + work("edited.json") + " --trajectory " +
+          work("traj.csv") + " --engine native --json " + work("z.json"));
+  EXPECT_EQ(edited.code, 1);
+  EXPECT_EQ(testing::error_contract_problem(edited.err), "") << edited.err;
+  EXPECT_NE(edited.err.find("covariance_matrix"), std::string::npos) << edited.err;
+  EXPECT_FALSE(fs::exists(work("z.json")));
 }
 
 }  // namespace

@@ -82,6 +82,31 @@ TEST(ExciteFamilyCli, TrapezoidCruisesAndSplinePassesItsViaPoints) {
   EXPECT_NEAR(dq2[300], 0.0, 1e-9);
 }
 
+// --family fourier --joint J: one period, exactly periodic in the written CSV, the other joints at
+// the pose, the range reached, and the written derivatives consistent with the written positions.
+TEST(ExciteFamilyCli, FourierOfOneJointIsPeriodicOverItsRange) {
+  const CsvTable t = excite(
+      "--robot planar2 --family fourier --joint 2 --range -0.5:0.3 --pose 0.4,0 --f0 0.2 "
+      "--harmonics 4 --rate 200");
+  ASSERT_EQ(t.data.rows(), 1001);  // 5 s at 200 Hz, both ends
+  const Eigen::VectorXd q1 = column(t, "q1"), dq1 = column(t, "dq1"), q2 = column(t, "q2"),
+                        dq2 = column(t, "dq2"), ddq2 = column(t, "ddq2");
+  EXPECT_EQ((q1.array() - 0.4).abs().maxCoeff(), 0.0);
+  EXPECT_EQ(dq1.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_NEAR(q2.minCoeff(), -0.5, 1e-4);
+  EXPECT_NEAR(q2.maxCoeff(), 0.3, 1e-4);
+  const Eigen::Index last = t.data.rows() - 1;
+  EXPECT_NEAR((t.data.row(0).tail(6) - t.data.row(last).tail(6)).norm(), 0.0, 1e-9);
+  EXPECT_NEAR(dq2[0], 0.0, 1e-9);  // at rest at the ends by default
+  EXPECT_NEAR(ddq2[0], 0.0, 1e-9);
+  // Central differences at 200 Hz: truncation error h^2/6 times the third derivative, about
+  // 4e-6 * (2 pi 0.8)^3 * 0.4 = 2e-4 for dq.
+  for (Eigen::Index k = 1; k < last; ++k) {
+    EXPECT_NEAR((q2[k + 1] - q2[k - 1]) * 100.0, dq2[k], 1e-3) << k;
+    EXPECT_NEAR((dq2[k + 1] - dq2[k - 1]) * 100.0, ddq2[k], 1e-2) << k;
+  }
+}
+
 TEST(ExciteFamilyCli, BadParametersGiveOneErrorLineAndNoFile) {
   const std::string out = (scratch() / "never.csv").string();
   std::filesystem::remove(out);
@@ -103,6 +128,12 @@ TEST(ExciteFamilyCli, BadParametersGiveOneErrorLineAndNoFile) {
       {"--robot planar2 --family spline --joint 1 --via 0,1", "--duration"},
       {"--robot planar2 --family bang-bang --joint 1 --range 0:1 --acceleration 1 --pose 1,2,3",
        "--pose"},
+      {"--robot planar2 --family fourier --joint 3 --range 0:1", "--joint 3"},
+      {"--robot planar2 --family fourier --joint 1", "--range"},
+      {"--robot puma560 --family fourier --joint 2 --range 0:3", "outside its allowed range"},
+      {"--robot planar2 --family fourier --joint 1 --range 0:1 --velocity-limit 0.1",
+       "narrow --range"},
+      {"--robot planar2 --family fourier --joint 1 --range 0:1 --harmonics 1", "--harmonics"},
   };
   for (const Case& c : cases) {
     const testing::CliResult r =

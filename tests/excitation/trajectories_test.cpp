@@ -1,6 +1,7 @@
 // Trajectory families: analytic derivatives against central finite differences of the position,
 // boundary conditions, via-point interpolation and continuity, profile velocities/accelerations
 // against their closed forms, and errors.
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -10,6 +11,7 @@
 #include "dynid/common/error.hpp"
 #include "dynid/excitation/bang_bang_trajectory.hpp"
 #include "dynid/excitation/fourier_trajectory.hpp"
+#include "dynid/excitation/joint_fourier.hpp"
 #include "dynid/excitation/polynomial_spline.hpp"
 #include "dynid/excitation/slope_trajectory.hpp"
 #include "dynid/excitation/trajectory_samples.hpp"
@@ -105,6 +107,88 @@ TEST(Fourier, Errors) {
   c.b[1].resize(3);
   EXPECT_THROW(FourierTrajectory{c}, Error);
   EXPECT_THROW(FourierCoefficients::zeros({2, 0}, 0.1), Error);
+}
+
+// One-joint Fourier reference (issue 14 item 1). Oracles: finite differences, a fine grid for the
+// range, a direct DFT for the spectrum, and the Schroeder formula evaluated term by term.
+TEST(JointFourier, MovesOnlyItsJointOverTheRangeAtRestAtTheEnds) {
+  const Eigen::Vector3d pose(0.3, -0.2, 0.5);
+  JointFourierOptions o;  // 5 harmonics at 0.1 Hz, at rest at the ends
+  const FourierTrajectory tr(joint_fourier_reference(pose, 1, 0.7, -0.4, o));
+  ASSERT_DOUBLE_EQ(tr.period(), 10.0);
+  for (double t : {0.0, 0.37, 1.9, 4.2, 7.3, 9.99}) expect_derivatives_match(tr, t, 1e-3, 1e-7);
+  for (double t : {0.0, tr.period()}) {
+    EXPECT_LT(std::abs(at(tr, t).dq[1]), 1e-12);
+    EXPECT_LT(std::abs(at(tr, t).ddq[1]), 1e-12);
+  }
+  const int m = 20000;
+  double lo = 1e9, hi = -1e9;
+  for (int i = 0; i <= m; ++i) {
+    const double t = tr.period() * i / m;
+    const State s = at(tr, t);
+    lo = std::min(lo, s.q[1]);
+    hi = std::max(hi, s.q[1]);
+    EXPECT_EQ(s.q[0], 0.3);  // the held joints are exactly at the pose, still
+    EXPECT_EQ(s.q[2], 0.5);
+    EXPECT_EQ(s.dq[0], 0.0);
+    EXPECT_EQ(s.ddq[2], 0.0);
+    if (i % 1000 == 0) {
+      EXPECT_NEAR((s.q - at(tr, t + 2 * tr.period()).q).norm(), 0.0, 1e-12);
+    }
+  }
+  // The fine grid reaches the range (to its spacing) and never leaves it (to round-off).
+  EXPECT_NEAR(lo, -0.4, 1e-6);
+  EXPECT_NEAR(hi, 0.7, 1e-6);
+  EXPECT_GE(lo, -0.4 - 1e-12);
+  EXPECT_LE(hi, 0.7 + 1e-12);
+}
+
+TEST(JointFourier, SpectrumHasLinesAtTheHarmonicsOnlyWithSchroederPhasesAndOneOverK) {
+  const Eigen::Vector2d pose(0.0, 0.0);
+  JointFourierOptions o;
+  o.harmonics = 5;
+  o.f0 = 0.2;
+  o.rest_at_ends = false;
+  const FourierTrajectory tr(joint_fourier_reference(pose, 0, -1.0, 0.5, o));
+  // Direct DFT of one period of q1, N samples.
+  const int n = 400;
+  Eigen::VectorXd q(n);
+  for (int i = 0; i < n; ++i) q[i] = at(tr, tr.period() * i / n).q[0];
+  std::vector<double> amplitude(n / 2), phase(n / 2);
+  for (int k = 0; k < n / 2; ++k) {
+    double re = 0, im = 0;
+    for (int i = 0; i < n; ++i) {
+      re += q[i] * std::cos(2 * M_PI * k * i / n);
+      im -= q[i] * std::sin(2 * M_PI * k * i / n);
+    }
+    amplitude[k] = 2 * std::hypot(re, im) / n;
+    phase[k] = std::atan2(im, re);
+  }
+  const double g = amplitude[1];  // the gain on sin(wt)/1
+  for (int k = 6; k < n / 2; ++k) EXPECT_LT(amplitude[k], 1e-12 * g) << "line at k = " << k;
+  for (int k = 1; k <= 5; ++k) {
+    EXPECT_NEAR(amplitude[k] * k, g, 1e-12 * g) << k;  // amplitudes g/k
+    // sin(x + φ) = cos(x + φ − π/2): the DFT phase of line k is φ_k − π/2 (mod 2π).
+    const double phi = -M_PI * k * (k - 1) / 5.0 - M_PI / 2;
+    EXPECT_NEAR(std::remainder(phase[k] - phi, 2 * M_PI), 0.0, 1e-9) << k;
+  }
+  // The scaled series spans exactly the range: min and max from the same samples, refined.
+  EXPECT_NEAR(q.minCoeff(), -1.0, 1e-3);
+  EXPECT_NEAR(q.maxCoeff(), 0.5, 1e-3);
+  EXPECT_LE(q.maxCoeff(), 0.5 + 1e-12);
+}
+
+TEST(JointFourier, Errors) {
+  const Eigen::Vector2d pose(0.0, 0.0);
+  EXPECT_THROW(joint_fourier_reference(pose, 2, -1.0, 1.0), Error);
+  EXPECT_THROW(joint_fourier_reference(pose, -1, -1.0, 1.0), Error);
+  EXPECT_THROW(joint_fourier_reference(pose, 0, 1.0, 1.0), Error);
+  JointFourierOptions o;
+  o.harmonics = 1;  // one harmonic at rest at both ends does not move
+  EXPECT_THROW(joint_fourier_reference(pose, 0, -1.0, 1.0, o), Error);
+  o.harmonics = 3;
+  o.f0 = 0.0;
+  EXPECT_THROW(joint_fourier_reference(pose, 0, -1.0, 1.0, o), Error);
 }
 
 TEST(Sampling, GridAndValues) {

@@ -39,6 +39,11 @@ struct IdentifiedResultFile {
   /// `not_excited`: base parameters the identification data did not determine (empty in files
   /// written before it was stored).
   std::vector<std::string> not_excited;
+  /// `parameters[].std` (NaN where absent or null), `covariance_matrix` (names × names) and
+  /// `data_regrouping` (names × not_excited, IdentificationResult::data_regrouping); the matrices
+  /// are empty in files written before they were stored.
+  Eigen::VectorXd std_devs;
+  Eigen::MatrixXd covariance, data_regrouping;
 };
 
 /// Reads a result JSON (identification_to_json). Throws dynid::Error naming the file when

@@ -1,0 +1,150 @@
+#include "dynid/estimation/completed_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/Dense>
+#include <Eigen/Eigenvalues>
+
+#include "dynid/common/error.hpp"
+#include "dynid/identifiability/base_parameters.hpp"
+#include "dynid/model/transmission.hpp"
+
+namespace dynid {
+namespace {
+
+std::string join(const std::vector<std::string>& names) {
+  std::string list;
+  for (const std::string& name : names) list += (list.empty() ? "" : ", ") + name;
+  return list;
+}
+
+}  // namespace
+
+CompletedModel complete_identified_model(
+    const Model& nominal, const std::vector<std::string>& names, const Eigen::VectorXd& values,
+    const Eigen::VectorXd& std_devs, const std::vector<std::string>& not_excited,
+    const Eigen::MatrixXd& data_regrouping, const Eigen::MatrixXd& covariance,
+    const IdentifyOptions& options, const ModelCompletionOptions& completion) {
+  const auto m = static_cast<Eigen::Index>(names.size());
+  const auto u = static_cast<Eigen::Index>(not_excited.size());
+  const Eigen::Index e = std_devs.size();  // the estimated ones; the rest were appended, known
+  if (values.size() != m || e > m ||
+      (covariance.size() != 0 && (covariance.rows() != e || covariance.cols() != e)) ||
+      (data_regrouping.size() != 0 &&
+       (data_regrouping.rows() > m || data_regrouping.cols() != u))) {
+    throw Error("complete_identified_model: values (" + std::to_string(values.size()) +
+                "), std_devs, covariance and data_regrouping must match the " + std::to_string(m) +
+                " names and " + std::to_string(u) + " not excited parameters");
+  }
+  // The base parameters of the nominal model with the result's layout (as identified_model()).
+  BaseParameterOptions bo = options.base;
+  bo.layout = options.layout;
+  bo.coupling = options.coupling && !coupled_motors(nominal).empty();
+  const BaseParameters base = compute_base_parameters(nominal, bo);
+  const int p = options.layout.columns(nominal.dof());
+  Eigen::VectorXd theta =
+      Eigen::VectorXd::Zero(static_cast<Eigen::Index>(base.layout_names.size()));
+  theta.head(p) = options.layout.parameters(nominal);
+  const Eigen::VectorXd nominal_b = base.reduce(theta);
+  auto index_of = [&](const std::string& name) {
+    const auto it = std::find(base.names.begin(), base.names.end(), name);
+    if (it == base.names.end()) {
+      throw Error("parameter '" + name + "' is not a base parameter of model '" + nominal.name +
+                  "' with this friction set; use the options the result was identified with");
+    }
+    return static_cast<Eigen::Index>(it - base.names.begin());
+  };
+  Eigen::VectorXd nominal_at(m);  // nominal value of each result name
+  std::vector<Eigen::Index> index(static_cast<size_t>(m));
+  for (Eigen::Index i = 0; i < m; ++i) {
+    index[static_cast<size_t>(i)] = index_of(names[static_cast<size_t>(i)]);
+    nominal_at[i] = nominal_b[index[static_cast<size_t>(i)]];
+  }
+  Eigen::VectorXd nominal_u(u);
+  for (Eigen::Index j = 0; j < u; ++j) nominal_u[j] = nominal_b[index_of(not_excited[j])];
+
+  CompletedModel out;
+  // Not excited: each estimate holds D·θ_u; with θ_u = θ_u⁰ the estimate of its own parameter is
+  // θ̂ − D·θ_u⁰.
+  Eigen::VectorXd x = values;
+  if (u > 0 && data_regrouping.size() != 0) {
+    x.head(data_regrouping.rows()) -= data_regrouping * nominal_u;
+  }
+  out.nominal_not_excited = not_excited;
+  if (u > 0 && data_regrouping.size() == 0) {
+    out.warnings.push_back(
+        "the result stores no data regroupings (written by an older dynid): the estimates still "
+        "contain the not excited parameters' share on the identification data");
+  }
+  // Badly determined directions: in the coordinates z_i = θ_i/s_i, s_i = max(|θ̂_i|, |θ_i⁰|), the
+  // eigenvectors of the covariance are independent estimates; those whose σ exceeds
+  // max_relative_std (the data do not fix even the order of magnitude along them) take the
+  // nominal model's component, the others keep the estimate's.
+  std::vector<Eigen::Index> bad, good;
+  Eigen::VectorXd nominal_share = Eigen::VectorXd::Zero(m);  // diag of the projector
+  if (e > 0 && completion.max_relative_std > 0.0) {
+    if (covariance.size() != 0 && covariance.allFinite()) {
+      Eigen::VectorXd scale(e);
+      for (Eigen::Index i = 0; i < e; ++i) {
+        scale[i] = std::max(std::abs(x[i]), std::abs(nominal_at[i]));
+        if (!(scale[i] > 0.0)) scale[i] = 1.0;  // both zero: any scale, nothing to move
+      }
+      const Eigen::MatrixXd scaled =
+          scale.cwiseInverse().asDiagonal() * covariance * scale.cwiseInverse().asDiagonal();
+      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (scaled + scaled.transpose()));
+      const double limit = completion.max_relative_std * completion.max_relative_std;
+      Eigen::MatrixXd undetermined(e, 0);
+      for (Eigen::Index k = 0; k < e; ++k) {
+        if (eig.eigenvalues()[k] > limit) {
+          undetermined.conservativeResize(Eigen::NoChange, undetermined.cols() + 1);
+          undetermined.col(undetermined.cols() - 1) = eig.eigenvectors().col(k);
+        }
+      }
+      out.undetermined_directions = static_cast<int>(undetermined.cols());
+      const Eigen::VectorXd dz = (nominal_at.head(e) - x.head(e)).cwiseQuotient(scale);
+      x.head(e) += scale.cwiseProduct(undetermined * (undetermined.transpose() * dz));
+      nominal_share.head(e) = undetermined.rowwise().squaredNorm();
+    } else {
+      out.warnings.push_back(
+          "the result stores no covariance matrix (written by an older dynid): only the not "
+          "excited parameters were filled; badly determined ones are used as estimated");
+    }
+  }
+  for (Eigen::Index i = 0; i < m; ++i) (nominal_share[i] > 0.5 ? bad : good).push_back(i);
+  for (Eigen::Index i : bad) out.nominal_badly_determined.push_back(names[static_cast<size_t>(i)]);
+  // Full base vector: nominal, overwritten by the identified ones.
+  out.names = base.names;
+  out.values = nominal_b;
+  for (Eigen::Index i : good) {
+    out.values[index[static_cast<size_t>(i)]] = x[i];
+    out.identified.push_back(names[static_cast<size_t>(i)]);
+  }
+  for (Eigen::Index i : bad) out.values[index[static_cast<size_t>(i)]] = x[i];
+  // How far the filling moved the identified parameters (D·θ_u⁰ and the conditioning), in σ.
+  for (Eigen::Index i : good) {
+    const double s = i < e ? std_devs[i] : std::nan("");
+    if (std::isfinite(s) && s > 0.0) {
+      out.max_shift_sigma = std::max(out.max_shift_sigma, std::abs(x[i] - values[i]) / s);
+    }
+  }
+  if (!out.nominal_not_excited.empty()) {
+    out.warnings.push_back("not excited by the identification data, nominal values used: " +
+                           join(out.nominal_not_excited));
+  }
+  if (out.undetermined_directions > 0) {
+    std::ostringstream s;
+    s << out.undetermined_directions
+      << " combination(s) of the parameters are badly determined (std above "
+      << completion.max_relative_std
+      << " x max(|estimate|, |nominal|)) and take the nominal model's values; mostly nominal now: "
+      << (out.nominal_badly_determined.empty() ? std::string("none")
+                                               : join(out.nominal_badly_determined));
+    out.warnings.push_back(s.str());
+  }
+  out.model = identified_model(nominal, out.names, out.values, options);
+  return out;
+}
+
+}  // namespace dynid
