@@ -173,7 +173,10 @@ ParameterLayout parse_friction(const std::string& text, bool armature) {
   return layout;
 }
 
-// --filter auto | none | butterworth[:ORDER] | chebyshev[:ORDER[:RIPPLE_DB]]
+}  // namespace
+
+// --filter auto | none | butterworth[:ORDER] | chebyshev[:ORDER[:RIPPLE_DB]] (commands.hpp;
+// dynid average uses it too).
 void parse_filter(const std::string& text, SignalOptions& s) {
   const auto parts = split(text, ':');
   const std::string kind = parts.empty() ? "" : parts[0];
@@ -195,6 +198,8 @@ void parse_filter(const std::string& text, SignalOptions& s) {
                      "chebyshev[:ORDER[:RIPPLE_DB]] (the cut-off is --cutoff)");
   }
 }
+
+namespace {
 
 IdentificationEstimator parse_estimator(const std::string& text) {
   if (text == "ols") return IdentificationEstimator::kOls;
