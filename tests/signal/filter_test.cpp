@@ -245,6 +245,17 @@ TEST(LowpassErrors, MessagesNameInputAndFix) {
   }
 }
 
+// Seed 2 §3.4's filter: 8th-order Chebyshev I, 0.5 dB ripple, 80 Hz at 1 kHz.
+LowpassOptions seed2_chebyshev() {
+  LowpassOptions o;
+  o.family = LowpassFamily::kChebyshev1;
+  o.order = 8;
+  o.cutoff_hz = 80.0;
+  o.sample_rate_hz = 1000.0;
+  o.ripple_db = 0.5;
+  return o;
+}
+
 // Seed 2's chain on an averaged period (dynid average --filter chebyshev:8 --cutoff 80
 // --decimate 5): one 2 s period at 1 kHz holding an in-band line (0.5 Hz, the top of seed 2's
 // excitation band), an out-of-band tone (150 Hz) and a constant. The in-band line passes with the
@@ -252,11 +263,7 @@ TEST(LowpassErrors, MessagesNameInputAndFix) {
 // an even-order Chebyshev I, no phase shift; the tone is gone; the constant is kept.
 TEST(PeriodicLowpass, InBandLinePassesWithTheRippleOutOfBandToneIsRemoved) {
   PeriodicLowpassOptions o;
-  o.design.family = LowpassFamily::kChebyshev1;
-  o.design.order = 8;
-  o.design.cutoff_hz = 80.0;
-  o.design.sample_rate_hz = 1000.0;
-  o.design.ripple_db = 0.5;
+  o.design = seed2_chebyshev();
   o.decimate = 5;
   const Eigen::Index p = 2000;
   Eigen::MatrixXd x(p, 2);
@@ -293,13 +300,7 @@ TEST(PeriodicLowpass, InBandLinePassesWithTheRippleOutOfBandToneIsRemoved) {
 // died out (an 80 Hz Chebyshev's slowest pole decays in ~100 samples; 5 periods of 300 samples
 // separate the middle from the edges).
 TEST(PeriodicLowpass, EqualsTheSteadyStateOfFiltfiltOnTheRepeatedPeriod) {
-  LowpassOptions o;
-  o.family = LowpassFamily::kChebyshev1;
-  o.order = 8;
-  o.cutoff_hz = 80.0;
-  o.sample_rate_hz = 1000.0;
-  o.ripple_db = 0.5;
-  const SosFilter f = design_lowpass_unit_dc(o);
+  const SosFilter f = design_lowpass_unit_dc(seed2_chebyshev());
   const Eigen::Index p = 300, repeats = 11;
   Eigen::MatrixXd x = Eigen::MatrixXd::Random(p, 2);  // fixed seed: Eigen's default rand()
   Eigen::MatrixXd long_x(p * repeats, 2);
@@ -311,10 +312,7 @@ TEST(PeriodicLowpass, EqualsTheSteadyStateOfFiltfiltOnTheRepeatedPeriod) {
 
 TEST(PeriodicLowpass, DecimationThatBreaksThePeriodOrAliasesIsAnError) {
   PeriodicLowpassOptions o;
-  o.design.family = LowpassFamily::kChebyshev1;
-  o.design.order = 8;
-  o.design.cutoff_hz = 80.0;
-  o.design.sample_rate_hz = 1000.0;
+  o.design = seed2_chebyshev();
   const Eigen::MatrixXd x = Eigen::MatrixXd::Ones(2000, 1);
   o.decimate = 3;
   try {
