@@ -526,8 +526,8 @@ std::string projected_statistics(Estimate& e, const EquationBlock& block,
         "the " + std::to_string(clusters) + " projected channels (joints x runs) disagree about " +
         widened.str() +
         " beyond their noise (interval widened by that factor): model error in some joint's "
-        "torque (e.g. the friction of a joint its controller holds), which may bias the "
-        "estimate; the widened interval allows for it");
+        "torque (e.g. a joint its controller holds, taken as still while it moves by its "
+        "tracking error), which may bias the estimate; the widened interval allows for it");
   fill_parameter_statistics(e, options);
   std::ostringstream c;
   c << std::setprecision(4) << "sigma^2 (W~^T W~)^-1 on the projected equations, sigma^2 = "
