@@ -10,10 +10,12 @@
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
+#include "dynid/estimation/identification.hpp"
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/io/csv_writer.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/signal/period_averaging.hpp"
+#include "dynid/signal/periodic_filter.hpp"
 
 namespace dynid::cli {
 namespace {
@@ -22,13 +24,43 @@ struct AverageCliOptions {
   std::string data, out, json;
   double period = 0.0, f0 = 0.0, start = std::nan("");
   int skip_periods = 0;
+  std::string filter = "none";  // --filter
+  double cutoff = 0.0;          // --cutoff [Hz]
+  int decimate = 1;             // --decimate
 };
+
+// The reference a controller followed is its own noise-free command, not a measurement: its
+// analytic derivatives (dqr*, ddqr*) must stay its derivatives, so the filter leaves it alone.
+bool is_reference_column(const std::string& name) {
+  for (const char* prefix : {"qr", "dqr", "ddqr"}) {
+    const std::string p = prefix;
+    if (name.size() > p.size() && name.compare(0, p.size(), p) == 0 &&
+        name.find_first_not_of("0123456789", p.size()) == std::string::npos)
+      return true;
+  }
+  return false;
+}
 
 void run(const AverageCliOptions& o) {
   if ((o.period > 0.0) == (o.f0 > 0.0))
     throw UsageError("give exactly one of --period S or --f0 HZ (> 0)");
   if (o.skip_periods < 0) throw UsageError("--skip-periods must be >= 0");
   const double period = o.period > 0.0 ? o.period : 1.0 / o.f0;
+  SignalOptions filter;
+  parse_filter(o.filter, filter);
+  const bool filtered = o.filter != "none";
+  if (o.filter == "auto")
+    throw UsageError(
+        "--filter auto chooses identify's cut-off from a run; for the averaged period name the "
+        "filter (butterworth[:ORDER] or chebyshev[:ORDER[:RIPPLE_DB]]) and give --cutoff HZ");
+  if (filtered && !(o.cutoff > 0.0))
+    throw UsageError("--filter " + o.filter + " needs --cutoff HZ (> 0), e.g. --cutoff 80");
+  if (!filtered && o.cutoff != 0.0)
+    throw UsageError("--cutoff sets the low-pass of --filter: give --filter too, e.g. chebyshev:8");
+  if (o.decimate < 1) throw UsageError("--decimate must be >= 1");
+  if (!filtered && o.decimate > 1)
+    throw UsageError("--decimate " + std::to_string(o.decimate) +
+                     " needs a low-pass against aliasing: give --filter and --cutoff too");
   const CsvTable table = read_csv(o.data);
   Eigen::Index t_col = -1;
   std::vector<std::string> names;
@@ -50,10 +82,39 @@ void run(const AverageCliOptions& o) {
   options.skip_periods = o.skip_periods;
   const TimedPeriodAverage a = average_periods_in_time(table.data.col(t_col), x, period, options);
 
+  // Seed 2 section 3.4: averaged, then low-passed (8th-order Chebyshev at 80 Hz) and resampled
+  // (200 Hz). The mean is one period of a periodic signal, so the zero-phase filter is circular:
+  // no edge transient, nothing trimmed. Averaging and filtering are both linear, so their order
+  // does not matter; the noise statistics stay those of the raw samples.
+  PeriodicLowpassOptions lowpass;
+  lowpass.design.family = filter.family;
+  lowpass.design.order = filter.order;
+  lowpass.design.ripple_db = filter.ripple_db;
+  lowpass.design.cutoff_hz = o.cutoff;
+  lowpass.design.sample_rate_hz = 1.0 / (period / static_cast<double>(a.mean.rows()));
+  lowpass.decimate = o.decimate;
+  std::vector<Eigen::Index> measured;  // columns filtered (every one but the reference's)
+  for (Eigen::Index c = 0; c < a.mean.cols(); ++c)
+    if (!is_reference_column(names[static_cast<size_t>(c)])) measured.push_back(c);
+  Eigen::MatrixXd kept = a.mean;
+  Eigen::VectorXd phase = a.phase;
+  if (filtered) {
+    Eigen::MatrixXd m(a.mean.rows(), static_cast<Eigen::Index>(measured.size()));
+    for (Eigen::Index c = 0; c < m.cols(); ++c) m.col(c) = a.mean.col(measured[c]);
+    const Eigen::MatrixXd f = lowpass_periodic(lowpass, m);
+    kept.resize(f.rows(), a.mean.cols());
+    phase.resize(f.rows());
+    for (Eigen::Index k = 0; k < f.rows(); ++k) {
+      kept.row(k) = a.mean.row(k * o.decimate);
+      phase[k] = a.phase[k * o.decimate];
+    }
+    for (Eigen::Index c = 0; c < f.cols(); ++c) kept.col(measured[c]) = f.col(c);
+  }
+
   std::vector<std::string> header = {"t"};
   header.insert(header.end(), names.begin(), names.end());
-  Eigen::MatrixXd mean(a.mean.rows(), a.mean.cols() + 1);
-  mean << a.phase, a.mean;
+  Eigen::MatrixXd mean(kept.rows(), kept.cols() + 1);
+  mean << phase, kept;
   nlohmann::json j;
   if (!o.json.empty()) {
     j["data"] = o.data;
@@ -68,6 +129,21 @@ void run(const AverageCliOptions& o) {
     j["samples_after"] = a.samples_after;
     j["partial_period"] = a.partial_period;
     j["residual_samples"] = a.residual_samples;
+    if (filtered) {
+      nlohmann::json unfiltered = nlohmann::json::array();
+      for (const std::string& name : names)
+        if (is_reference_column(name)) unfiltered.push_back(name);
+      j["filter"] = {
+          {"family", filter.family == LowpassFamily::kChebyshev1 ? "chebyshev" : "butterworth"},
+          {"order", filter.order},
+          {"ripple_db", filter.family == LowpassFamily::kChebyshev1 ? json_number(filter.ripple_db)
+                                                                    : nlohmann::json()},
+          {"cutoff_hz", o.cutoff},
+          {"decimate", o.decimate},
+          {"rate_hz", lowpass.design.sample_rate_hz / o.decimate},
+          {"rows", kept.rows()},
+          {"unfiltered", unfiltered}};
+    }
     j["channels"] = nlohmann::json::array();
     for (std::size_t c = 0; c < names.size(); ++c) {
       const ChannelNoise& ch = a.channels[c];
@@ -84,6 +160,14 @@ void run(const AverageCliOptions& o) {
             << short_number(a.samples_per_period) << " samples"
             << (a.interpolated ? ", interpolated between samples" : "") << "); wrote " << o.out
             << (o.json.empty() ? "" : " and " + o.json) << '\n';
+  if (filtered)
+    std::cout << "filtered the mean period circularly (" << o.filter << ", zero phase, cut-off "
+              << short_number(o.cutoff) << " Hz)"
+              << (o.decimate > 1 ? ", kept every " + std::to_string(o.decimate) + "th sample (" +
+                                       short_number(lowpass.design.sample_rate_hz / o.decimate) +
+                                       " Hz, " + std::to_string(kept.rows()) + " rows)"
+                                 : std::string())
+              << "; reference columns (qr*, dqr*, ddqr*) left as logged\n";
   if (a.samples_after > 0)
     std::cout << "note: the last " << a.samples_after << " samples ("
               << short_number(a.partial_period)
@@ -118,6 +202,16 @@ void add_average_command(CLI::App& app) {
                   "Time of the first period's start [s]; default the first sample");
   cmd->add_option("--skip-periods", o->skip_periods,
                   "Complete periods dropped at the start (transient)")
+      ->capture_default_str();
+  cmd->add_option("--filter", o->filter,
+                  "Zero-phase low-pass of the mean period, applied circularly (no edges): none, "
+                  "butterworth[:ORDER] or chebyshev[:ORDER[:RIPPLE_DB]] (order 8 as in Bona and "
+                  "Curatella); reference columns qr*, dqr*, ddqr* are not filtered")
+      ->capture_default_str();
+  cmd->add_option("--cutoff", o->cutoff, "Cut-off of --filter [Hz] (Chebyshev: passband edge)");
+  cmd->add_option("--decimate", o->decimate,
+                  "Keep every N-th sample of the filtered period (must divide its samples; the "
+                  "cut-off must be below the new Nyquist rate), e.g. 5 for 1 kHz to 200 Hz")
       ->capture_default_str();
   cmd->callback([o] { run(*o); });
 }

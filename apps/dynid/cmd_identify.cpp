@@ -174,7 +174,10 @@ ParameterLayout parse_friction(const std::string& text, bool armature) {
   return layout;
 }
 
-// --filter auto | none | butterworth[:ORDER] | chebyshev[:ORDER[:RIPPLE_DB]]
+}  // namespace
+
+// --filter auto | none | butterworth[:ORDER] | chebyshev[:ORDER[:RIPPLE_DB]] (commands.hpp;
+// dynid average uses it too).
 void parse_filter(const std::string& text, SignalOptions& s) {
   const auto parts = split(text, ':');
   const std::string kind = parts.empty() ? "" : parts[0];
@@ -196,6 +199,8 @@ void parse_filter(const std::string& text, SignalOptions& s) {
                      "chebyshev[:ORDER[:RIPPLE_DB]] (the cut-off is --cutoff)");
   }
 }
+
+namespace {
 
 IdentificationEstimator parse_estimator(const std::string& text) {
   if (text == "ols") return IdentificationEstimator::kOls;
@@ -357,6 +362,24 @@ void warn_identify_no_effect(const IdentifyCliOptions& o, const CLI::App& cmd) {
     warn("--cutoff and --filter-coulomb have no effect with --filter none");
   }
   if (!o.stream && cmd.count("--threads")) warn("--threads has no effect without --stream");
+  if (o.closed_loop == "none") return;
+  // The closed-loop preparation keeps the reference's band (the lines up to it, or the FIR's
+  // span), computes the derivatives from the reference and keeps every row: these flags would
+  // change nothing in that band, so they are named, not silently dropped.
+  const std::string seed2 =
+      " (the projection keeps only the reference's band); to filter and resample as Bona and "
+      "Curatella did, give it to dynid average (--filter chebyshev:8 --cutoff 80 --decimate 5 on "
+      "the averaged period)";
+  const std::pair<const char*, std::string> ignored[] = {
+      {"--filter", seed2},
+      {"--cutoff", seed2},
+      {"--decimate", seed2},
+      {"--trim", " (no filter edges to trim)"},
+      {"--savgol", " (the derivatives come from the reference, analytically)"},
+      {"--zero-velocity", " (every row is kept so that the projection applies to whole signals)"},
+      {"--filter-coulomb", " (the regressor columns are projected like tau)"}};
+  for (const auto& [flag, why] : ignored)
+    if (cmd.count(flag)) warn(std::string(flag) + " has no effect with --closed-loop" + why);
 }
 
 // The options a result JSON records, read with the file and key named in any error (a wrong type

@@ -12,6 +12,10 @@
 #include "dynid/estimation/completed_model.hpp"
 #include "dynid/model/model.hpp"
 
+namespace dynid {
+struct SignalOptions;
+}
+
 namespace dynid::cli {
 
 /// Registers every subcommand below on `app` and the NaN/Inf check of their numeric flags
@@ -42,6 +46,11 @@ void add_simulate_command(CLI::App& app);
 
 /// `dynid average`: mean period and noise statistics of a periodic run (cmd_average.cpp).
 void add_average_command(CLI::App& app);
+
+/// Reads `--filter auto|none|butterworth[:ORDER]|chebyshev[:ORDER[:RIPPLE_DB]]` into s.filter,
+/// family, order (Chebyshev default 8, seed 2 §3.4), ripple_db; "auto" leaves s unchanged.
+/// Throws UsageError naming the forms (cmd_identify.cpp; identify and average).
+void parse_filter(const std::string& text, SignalOptions& s);
 
 /// `dynid payload`: a gripped load's parameters from a wrist force/torque sensor (cmd_payload.cpp).
 void add_payload_command(CLI::App& app);

@@ -6,9 +6,10 @@
 #   1. gravity of joints 2 and 3 from two constant-velocity slopes (Table 1);
 #   2. friction of every joint from bang-bang moves, inertia and gravity compensated (Table 2);
 #   3. a 5-harmonic Fourier reference at f0 = 0.1 Hz, ONE JOINT AT A TIME (the others held),
-#      PERIODS periods each, averaged into one period (dynid average), then the spectral
-#      projection (lines of f0 up to the band, analytic derivatives) and least squares on the
-#      union of the six runs with the friction of step 2 subtracted (Table 3);
+#      PERIODS periods each, averaged into one period, low-passed by an 8th-order Chebyshev at
+#      80 Hz and resampled at 200 Hz (dynid average --filter --cutoff --decimate), then the
+#      spectral projection (lines of f0 up to the band, analytic derivatives) and least squares
+#      on the union of the six runs with the friction of step 2 subtracted (Table 3);
 #   4. validation by simulation on trapezoidal references, one joint at a time (Fig. 8);
 #   5. the computed-torque controller built from the identified model against the PID (Fig. 9).
 # Prints Tables 1-3 with the truth beside them, what the one-joint runs cannot determine, and the
@@ -16,12 +17,9 @@
 #
 # Usage: examples/comau-s2/run.sh [OUT_DIR]   (default comau-s2-out; DYNID=path/to/dynid)
 # Environment: PERIODS (25, as in the paper), RATE (control and logging rate, 1000 Hz as in the
-#   paper), SEED (1). Runtime on 2 busy shared cores: 5-7 min with the defaults; PERIODS=3
-#   RATE=200 (the test's setting) about 9 s of CPU, 27-80 s wall clock.
-# Not in this chain: the paper's 8th-order Chebyshev filter at 80 Hz and resampling to 200 Hz.
-#   `identify --closed-loop spectral` replaces filtering and decimation by the projection on the
-#   lines at or below the excitation band (0.5 Hz), which removes everything a filter at 80 Hz
-#   would, so the step would change nothing but the run length.
+#   paper; a multiple of 200, the rate the averaged periods are resampled to), SEED (1). Runtime
+#   on 2 busy shared cores: 5-7 min with the defaults; PERIODS=3 RATE=200 (the test's setting)
+#   about 9 s of CPU, 27-80 s wall clock.
 set -euo pipefail
 if [ $# -gt 1 ]; then
   echo "usage: $0 [OUT_DIR]" >&2
@@ -38,6 +36,8 @@ offset=(--torque-offset "$(awk -v r="$rate" 'BEGIN { print 0.5 / r }')")
 [ -x "$dynid" ] || { echo "error: $dynid not found; build it first with ./scripts/build" >&2; exit 1; }
 command -v python3 >/dev/null || { echo "error: python3 is needed to print the tables" >&2; exit 1; }
 [ "$periods" -ge 2 ] || { echo "error: PERIODS must be >= 2 (the first is a transient)" >&2; exit 2; }
+[ $((rate % 200)) -eq 0 ] && [ "$rate" -gt 0 ] ||
+  { echo "error: RATE must be a positive multiple of 200 Hz (the averaged periods are resampled to 200 Hz)" >&2; exit 2; }
 mkdir -p "$out"
 robot=comau-s2
 f0=0.1
@@ -92,15 +92,20 @@ data=()
 for j in 1 2 3 4 5 6; do
   fourier $j "${ranges[$((j - 1))]}" "$out/fourier_$j.csv"
   sim "$out/fourier_$j.csv" "$out/fourier_run_$j.csv" "$periods" $((seed + 20 + j))
-  # The first period is the loop's transient; the others are averaged into one.
+  # The first period is the loop's transient; the others are averaged into one, which is then
+  # low-passed (Chebyshev 8 at 80 Hz, zero phase, circular: it is one period of a periodic
+  # signal) and resampled at 200 Hz, as in the paper's section 3.4. The reference columns are
+  # left as logged.
   "$dynid" average --data "$out/fourier_run_$j.csv" --f0 $f0 --skip-periods 1 \
+    --filter chebyshev:8 --cutoff 80 --decimate $((rate / 200)) \
     --out "$out/avg_$j.tmp.csv" --json "$out/noise_$j.json" > "$out/average_$j.log" 2>&1
   # The averaged period starts at a reference period's start: the reference's analytic derivatives
-  # join it as dqr*, ddqr* (they tell the spectral projection that this one period is periodic).
+  # join it as dqr*, ddqr* (they tell the spectral projection that this one period is periodic),
+  # at the kept samples (every RATE/200-th).
   rows=$(($(wc -l < "$out/avg_$j.tmp.csv") - 1))
-  awk -F, -v rows="$rows" 'NR == 1 { h = "dqr1"; for (j = 2; j <= 6; ++j) h = h ",dqr" j;
+  awk -F, -v rows="$rows" -v dec=$((rate / 200)) 'NR == 1 { h = "dqr1"; for (j = 2; j <= 6; ++j) h = h ",dqr" j;
       for (j = 1; j <= 6; ++j) h = h ",ddqr" j; print h; next }
-    NR <= rows + 1 { s = $8; for (c = 9; c <= 19; ++c) s = s "," $c; print s }' \
+    (NR - 2) % dec == 0 && (NR - 2) / dec < rows { s = $8; for (c = 9; c <= 19; ++c) s = s "," $c; print s }' \
     "$out/fourier_$j.csv" | paste -d, "$out/avg_$j.tmp.csv" - > "$out/avg_$j.csv"
   rm "$out/avg_$j.tmp.csv"
   data+=(--data "$out/avg_$j.csv")

@@ -9,6 +9,7 @@
 #include <complex>
 #include <iomanip>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include <boost/math/distributions/students_t.hpp>
@@ -433,8 +434,11 @@ EquationBlock project_equations(const EquationBlock& block, const SignalProjecto
 
 std::string projected_statistics(Estimate& e, const EquationBlock& block,
                                  Eigen::Index effective_rows, bool weighted,
-                                 const EstimationOptions& options) {
+                                 const EstimationOptions& options, const Eigen::VectorXi& channel) {
   const Eigen::Index rows = block.W.rows(), p = block.W.cols();
+  if (channel.size() != 0 && channel.size() != rows)
+    throw Error("projected_statistics: " + std::to_string(channel.size()) + " channel labels for " +
+                std::to_string(rows) + " rows");
   Eigen::VectorXd w = Eigen::VectorXd::Ones(rows);
   if (weighted && e.group_variance.size()) {
     for (Eigen::Index i = 0; i < rows; ++i) {
@@ -468,11 +472,45 @@ std::string projected_statistics(Estimate& e, const EquationBlock& block,
   const double sigma2 = ew.squaredNorm() / dof;
   const Eigen::MatrixXd v = svd.matrixV();
   const Eigen::MatrixXd inv_scaled = v * inv2.asDiagonal() * v.transpose();
-  e.covariance =
-      sigma2 * s.cwiseInverse().asDiagonal() * inv_scaled * s.cwiseInverse().asDiagonal();
+  const Eigen::MatrixXd bread =
+      s.cwiseInverse().asDiagonal() * inv_scaled * s.cwiseInverse().asDiagonal();
+  e.covariance = sigma2 * bread;
+  // Channel-clustered sandwich, per parameter the larger of it and the white variance.
+  std::ostringstream widened;
+  int clusters = 0;
+  if (channel.size() == rows) {
+    std::map<int, Eigen::VectorXd> score;
+    for (Eigen::Index i = 0; i < rows; ++i) {
+      auto it = score.try_emplace(channel[i], Eigen::VectorXd::Zero(p)).first;
+      it->second += Ww.row(i).transpose() * ew[i];
+    }
+    clusters = static_cast<int>(score.size());
+    if (clusters >= 2) {
+      Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(p, p);
+      for (const auto& [c, g] : score) meat.selfadjointView<Eigen::Lower>().rankUpdate(g);
+      meat = meat.selfadjointView<Eigen::Lower>();
+      const double n_eff = static_cast<double>(effective_rows);
+      meat *= clusters / (clusters - 1.0) * (n_eff - 1.0) / dof;
+      const Eigen::MatrixXd clustered = bread * meat * bread;
+      Eigen::VectorXd scale = Eigen::VectorXd::Ones(p);
+      widened << std::setprecision(3);
+      for (Eigen::Index k = 0; k < p; ++k) {
+        const double white = e.covariance(k, k);
+        if (!(white > 0.0) || !(clustered(k, k) > white)) continue;
+        scale[k] = std::sqrt(clustered(k, k) / white);
+        if (scale[k] > 1.2)
+          widened << (widened.tellp() > 0 ? ", " : "")
+                  << (k < static_cast<Eigen::Index>(options.names.size())
+                          ? options.names[static_cast<size_t>(k)]
+                          : "#" + std::to_string(k))
+                  << " x" << scale[k];
+      }
+      e.covariance = scale.asDiagonal() * e.covariance * scale.asDiagonal();
+    }
+  }
   e.residual_variance = sigma2;
   e.degrees_of_freedom = effective_rows - rank;
-  e.covariance_kind = "white, projected";
+  e.covariance_kind = clusters >= 2 ? "white or channel-clustered, projected" : "white, projected";
   e.std_dev_white.resize(0);
   e.ci_lower_white.resize(0);
   e.ci_upper_white.resize(0);
@@ -483,6 +521,13 @@ std::string projected_statistics(Estimate& e, const EquationBlock& block,
                                          std::string::npos;
                                 }),
                  warnings.end());
+  if (widened.tellp() > 0)
+    e.summary.warnings.push_back(
+        "the " + std::to_string(clusters) + " projected channels (joints x runs) disagree about " +
+        widened.str() +
+        " beyond their noise (interval widened by that factor): model error in some joint's "
+        "torque (e.g. a joint its controller holds, taken as still while it moves by its "
+        "tracking error), which may bias the estimate; the widened interval allows for it");
   fill_parameter_statistics(e, options);
   std::ostringstream c;
   c << std::setprecision(4) << "sigma^2 (W~^T W~)^-1 on the projected equations, sigma^2 = "
@@ -490,6 +535,9 @@ std::string projected_statistics(Estimate& e, const EquationBlock& block,
     << effective_rows << " dimensions (rank per channel, "
     << "all joints and runs), not one per row (" << rows << "); Student-t intervals with "
     << e.degrees_of_freedom << " degrees of freedom";
+  if (clusters >= 2)
+    c << "; per parameter the larger of that and the channel-clustered sandwich over the "
+      << clusters << " projected channels (joints x runs; Angrist-Pischke max rule)";
   return c.str();
 }
 

@@ -604,9 +604,17 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
     EstimationOptions so;
     so.confidence_level = options.confidence_level;
     so.names = W.columns;
+    // Channel of each row: run × joint, the projected series the clustered sandwich sums over.
+    Eigen::VectorXi channel(W.y.size());
+    Eigen::Index at = 0;
+    for (size_t b = 0; b < blocks.size(); ++b) {
+      const Eigen::Index rows = blocks[b].y.size();
+      channel.segment(at, rows) = W.group.segment(at, rows).array() + static_cast<int>(b) * n;
+      at += rows;
+    }
     fit.covariance_choice =
         projected_statistics(fit.estimate, W, projected_dimensions,
-                             options.estimator == IdentificationEstimator::kWls, so);
+                             options.estimator == IdentificationEstimator::kWls, so, channel);
   }
   if (ml) {
     projected.dimensions = projected_dimensions;

@@ -2,10 +2,12 @@
 // periodic signal and Gaussian noise of known std at a fixed seed.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -79,6 +81,82 @@ TEST_F(AverageCli, APeriodWithoutTwoPeriodsIsOneErrorLineAndNothingWritten) {
   const auto u = run("average --data " + work("run.csv") + " --out " + work("avg.csv"));
   EXPECT_EQ(u.code, 2);
   EXPECT_EQ(u.err, "error: give exactly one of --period S or --f0 HZ (> 0)\n");
+}
+
+// Seed 2's chain (25 periods averaged, Chebyshev 8 at 80 Hz, 200 Hz) through the binary: three
+// 2 s periods at 1 kHz of q1 = an in-band line (0.5 Hz) plus a 150 Hz tone, and its noise-free
+// reference qr1. The averaged period comes out at 200 Hz (400 rows) with the line scaled by the
+// documented passband ripple only (two-pass gain in [1, 1 + eps^2], no shift), the tone gone,
+// and qr1 as logged.
+TEST_F(AverageCli, FilterAndDecimateKeepTheBandAndRemoveAnOutOfBandTone) {
+  {
+    std::ofstream f(work("fast.csv"));
+    f.precision(17);
+    f << "t,qr1,q1\n";
+    for (int k = 0; k < 6000; ++k) {
+      const double t = k * 0.001, line = std::sin(2 * M_PI * 0.5 * t);
+      f << t << ',' << line << ',' << line + 0.3 * std::sin(2 * M_PI * 150.0 * t) << '\n';
+    }
+  }
+  const std::string base =
+      "average --data " + work("fast.csv") + " --period 2 --out " + work("avg.csv");
+  const auto r = run(base + " --json " + work("noise.json") +
+                     " --filter chebyshev:8 --cutoff 80 --decimate 5");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("kept every 5th sample (200 Hz, 400 rows)"), std::string::npos) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(std::ifstream(work("noise.json")));
+  EXPECT_EQ(j["filter"]["rate_hz"], 200.0);
+  EXPECT_EQ(j["filter"]["unfiltered"], nlohmann::json::array({"qr1"}));
+  std::ifstream avg(work("avg.csv"));
+  std::string line;
+  std::getline(avg, line);
+  EXPECT_EQ(line, "t,qr1,q1");
+  const double eps2 = std::pow(10.0, 0.05) - 1.0;  // 0.5 dB ripple
+  int rows = 0;
+  double worst_gain = 0.0, worst_shape = 0.0, worst_reference = 0.0, gain = 0.0;
+  while (std::getline(avg, line)) {
+    double t = 0, qr = 0, q = 0;
+    char c1 = 0, c2 = 0;
+    std::istringstream(line) >> t >> c1 >> qr >> c2 >> q;
+    EXPECT_NEAR(t, rows * 0.005, 1e-12);
+    const double truth = std::sin(2 * M_PI * 0.5 * t);
+    worst_reference = std::max(worst_reference, std::abs(qr - truth));
+    if (std::abs(truth) > 0.5) {
+      gain = q / truth;  // one gain for the whole line: zero phase
+      worst_gain = std::max(worst_gain, std::abs(gain - 1.0));
+    }
+    ++rows;
+  }
+  EXPECT_EQ(rows, 400);
+  EXPECT_LT(worst_reference, 1e-12);  // not filtered
+  EXPECT_GE(gain, 1.0 - 1e-9);
+  EXPECT_LE(worst_gain, eps2);  // in-band: the passband ripple, no more
+  // The tone (0.3) would move q1/sin by up to 0.6 where |sin| > 0.5; what is left is < 1e-6.
+  std::ifstream again(work("avg.csv"));
+  std::getline(again, line);
+  for (int k = 0; std::getline(again, line); ++k) {
+    double t = 0, qr = 0, q = 0;
+    char c1 = 0, c2 = 0;
+    std::istringstream(line) >> t >> c1 >> qr >> c2 >> q;
+    worst_shape = std::max(worst_shape, std::abs(q - gain * std::sin(2 * M_PI * 0.5 * t)));
+  }
+  EXPECT_LT(worst_shape, 1e-6);
+  // A factor that does not divide the 2000 samples, and an aliasing one: one error, no output.
+  fs::remove(work("avg.csv"));
+  const auto bad = run(base + " --filter chebyshev:8 --cutoff 80 --decimate 3");
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_EQ(bad.err.rfind("error: decimation by 3 does not divide the period's 2000 samples", 0),
+            0u)
+      << bad.err;
+  const auto alias = run(base + " --filter chebyshev:8 --cutoff 80 --decimate 10");
+  EXPECT_EQ(alias.code, 1);
+  EXPECT_NE(alias.err.find("would alias"), std::string::npos) << alias.err;
+  const auto usage = run(base + " --decimate 5");
+  EXPECT_EQ(usage.code, 2);
+  EXPECT_EQ(usage.err,
+            "error: --decimate 5 needs a low-pass against aliasing: give --filter and --cutoff "
+            "too\n");
+  EXPECT_FALSE(fs::exists(work("avg.csv")));
 }
 
 }  // namespace

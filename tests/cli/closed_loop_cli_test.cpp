@@ -107,6 +107,22 @@ TEST(ClosedLoopCli, ProjectionSpectralAndRepeatWriteTheirJson) {
   EXPECT_NE(j["choices"]["covariance"].get<std::string>().find("degrees of freedom"),
             std::string::npos);
   EXPECT_NE(j["choices"]["period"].get<std::string>().find("given: 5 s"), std::string::npos);
+
+  // Flags the closed-loop preparation does not use: one warning naming each, the same result.
+  const std::string spectral =
+      "identify --robot planar2 --data " + data + " --closed-loop spectral --f0 0.2 --out ";
+  r = run(spectral + path("plain.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run(spectral + path("flags.json") + " --filter chebyshev:8 --cutoff 40 --decimate 2");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* flag : {"--filter", "--cutoff", "--decimate"})
+    EXPECT_NE(r.err.find(std::string("warning: ") + flag + " has no effect with --closed-loop"),
+              std::string::npos)
+        << r.err;
+  const nlohmann::json plain = load(path("plain.json")), flags = load(path("flags.json"));
+  ASSERT_EQ(plain["parameters"].size(), flags["parameters"].size());
+  for (size_t i = 0; i < plain["parameters"].size(); ++i)
+    EXPECT_EQ(plain["parameters"][i]["value"], flags["parameters"][i]["value"]);
 }
 
 // One `error:` line, the exit code, and no result file.

@@ -3,6 +3,7 @@
 // the built-in comau-s2 under a plain PID, shortened (2 periods per Fourier run after the
 // transient, 200 Hz) but with every step of the chain. The truth in summary.json comes from the
 // model file and dynid inverse-dynamics, never from an estimate.
+#include <unistd.h>
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -20,8 +21,10 @@ nlohmann::json load(const std::filesystem::path& path) {
   return nlohmann::json::parse(f);
 }
 
-TEST(ComauS2Example, TruthInsideTheIntervalsButOneKnownBiasAndComputedTorqueTracksBetter) {
-  const auto out = std::filesystem::path(::testing::TempDir()) / "comau_s2";
+TEST(ComauS2Example, TruthInsideTheIntervalsAndComputedTorqueTracksBetter) {
+  // Per process: checkouts built side by side must not share (and delete) one folder.
+  const auto out =
+      std::filesystem::path(::testing::TempDir()) / ("comau_s2_" + std::to_string(::getpid()));
   std::filesystem::remove_all(out);
   const std::string command =
       std::string("DYNID='") + DYNID_BINARY + "' PERIODS=3 RATE=200 SEED=1 '" + DYNID_SOURCE_DIR +
@@ -36,15 +39,21 @@ TEST(ComauS2Example, TruthInsideTheIntervalsButOneKnownBiasAndComputedTorqueTrac
     if (!(lo <= truth && truth <= hi)) outside.push_back("Table " + t + " " + name);
     ++table[std::stoi(t)];
   }
-  // KNOWN BIAS (docs/methods/experiments.md, "Seed 2's case in simulation"): a held joint slides
-  // by its tracking error inside the plant's Coulomb smoothing band, and that friction in its
-  // torque rows pulls MY3R 3.5 sigma off (3.9 sigma with 25 periods at 1 kHz). Every other
-  // interval holds the truth; this fails as soon as anything else leaves its interval, or once
-  // the bias is fixed (then drop this exception).
-  EXPECT_EQ(outside, std::vector<std::string>{"Table 3 MY3R"});
+  // Every interval holds the truth. MY3R is still biased (a held joint slides by its tracking
+  // error inside the plant's Coulomb smoothing band; docs/methods/experiments.md, "Seed 2's case
+  // in simulation"), but its interval says so: the channels disagree about it and the
+  // channel-clustered covariance widens it (checked below through the result's warning).
+  EXPECT_EQ(outside, std::vector<std::string>{});
   EXPECT_EQ(table[1], 4);                          // k, q_off of joints 2 and 3
   EXPECT_EQ(table[2], 6 * 4);                      // Fvp Fvn Fcp Fcn of every joint
   EXPECT_EQ(table[3], s["data_rank"].get<int>());  // every excited base parameter checked
+  // The model error is named, not hidden: MY3R's interval is the one widened.
+  const nlohmann::json result = load(out / "result.json");
+  std::string widened;
+  for (const auto& w : result["warnings"])
+    if (w.get<std::string>().find("channels (joints x runs) disagree") != std::string::npos)
+      widened = w;
+  EXPECT_NE(widened.find("MY3R x"), std::string::npos) << widened;
   // Seed 2 Fig. 9: the model-based controller's peak tracking error is below the PID's.
   const nlohmann::json c = load(out / "control.json");
   double peak[2] = {0.0, 0.0};

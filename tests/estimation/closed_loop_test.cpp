@@ -95,6 +95,9 @@ TEST(ClosedLoopIdentification, ProjectionAndSpectralRemoveTheBiasOfDirectOls) {
       for (Eigen::Index i = 0; i < truth.size(); ++i)
         outside[k] += truth[i] < r.estimate.ci_lower[i] || truth[i] > r.estimate.ci_upper[i];
       if (k == 0) total += static_cast<int>(truth.size());
+      for (const std::string& w : r.warnings)  // the channel-clustered widening, if any
+        if (k > 0 && w.find("disagree") != std::string::npos)
+          std::printf("seed %d %s: %s\n", s, label[k], w.c_str());
       if (s == 0 && k > 0) {
         ASSERT_EQ(r.closed_loop.size(), 1u);
         std::printf("%s: rank %d per channel, M1 = %d, dof %ld\n", label[k], r.closed_loop[0].rank,

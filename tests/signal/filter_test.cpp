@@ -8,6 +8,7 @@
 
 #include "dynid/common/error.hpp"
 #include "dynid/signal/lowpass_design.hpp"
+#include "dynid/signal/periodic_filter.hpp"
 #include "dynid/signal/zero_phase_filter.hpp"
 
 namespace dynid {
@@ -242,6 +243,98 @@ TEST(LowpassErrors, MessagesNameInputAndFix) {
     EXPECT_STREQ(e.what(),
                  "sosfilt initial state is 3x2: give sections x 2 (4x2) or an empty matrix");
   }
+}
+
+// Seed 2 §3.4's filter: 8th-order Chebyshev I, 0.5 dB ripple, 80 Hz at 1 kHz.
+LowpassOptions seed2_chebyshev() {
+  LowpassOptions o;
+  o.family = LowpassFamily::kChebyshev1;
+  o.order = 8;
+  o.cutoff_hz = 80.0;
+  o.sample_rate_hz = 1000.0;
+  o.ripple_db = 0.5;
+  return o;
+}
+
+// Seed 2's chain on an averaged period (dynid average --filter chebyshev:8 --cutoff 80
+// --decimate 5): one 2 s period at 1 kHz holding an in-band line (0.5 Hz, the top of seed 2's
+// excitation band), an out-of-band tone (150 Hz) and a constant. The in-band line passes with the
+// documented ripple: exactly the analytic prototype's |H_a|² (unit DC), within [1, 1 + eps²] for
+// an even-order Chebyshev I, no phase shift; the tone is gone; the constant is kept.
+TEST(PeriodicLowpass, InBandLinePassesWithTheRippleOutOfBandToneIsRemoved) {
+  PeriodicLowpassOptions o;
+  o.design = seed2_chebyshev();
+  o.decimate = 5;
+  const Eigen::Index p = 2000;
+  Eigen::MatrixXd x(p, 2);
+  for (Eigen::Index k = 0; k < p; ++k) {
+    const double t = static_cast<double>(k) / 1000.0;
+    x(k, 0) = 0.7 + std::sin(2 * kPi * 0.5 * t) + 0.3 * std::sin(2 * kPi * 150.0 * t);
+    x(k, 1) = -2.0 * std::cos(2 * kPi * 0.5 * t);
+  }
+  const Eigen::MatrixXd y = lowpass_periodic(o, x);
+  ASSERT_EQ(y.rows(), p / 5);
+  ASSERT_EQ(y.cols(), 2);
+  // Oracle: the analog prototype's magnitude at the pre-warped frequency (not the sections).
+  const double eps2 = std::pow(10.0, 0.5 / 10.0) - 1.0;
+  const double dc = analytic_magnitude(o.design, 0.0);
+  const double g = std::pow(analytic_magnitude(o.design, 0.5) / dc, 2);
+  EXPECT_GE(g, 1.0 - 1e-12);
+  EXPECT_LE(g, 1.0 + eps2);
+  const double tone = std::pow(analytic_magnitude(o.design, 150.0) / dc, 2);
+  EXPECT_LT(tone, 1e-7);  // -140 dB over the two passes
+  double worst = 0.0, in_band = 0.0;
+  for (Eigen::Index k = 0; k < y.rows(); ++k) {
+    const double t = static_cast<double>(5 * k) / 1000.0;
+    const double line = 0.7 + g * std::sin(2 * kPi * 0.5 * t);
+    worst = std::max(worst, std::abs(y(k, 0) - line - 0.3 * tone * std::sin(2 * kPi * 150 * t)));
+    worst = std::max(worst, std::abs(y(k, 1) + 2.0 * g * std::cos(2 * kPi * 0.5 * t)));
+    in_band = std::max(in_band, std::abs(y(k, 0) - line));
+  }
+  EXPECT_LT(worst, 1e-10);
+  EXPECT_LT(in_band, 0.3e-7);  // what is left of the tone
+}
+
+// Independent algorithm: the time-domain forward-backward filter (filtfilt) on the period
+// repeated 11 times, middle period, is the circular filter's result once the edge transient has
+// died out (an 80 Hz Chebyshev's slowest pole decays in ~100 samples; 5 periods of 300 samples
+// separate the middle from the edges).
+TEST(PeriodicLowpass, EqualsTheSteadyStateOfFiltfiltOnTheRepeatedPeriod) {
+  const SosFilter f = design_lowpass_unit_dc(seed2_chebyshev());
+  const Eigen::Index p = 300, repeats = 11;
+  Eigen::MatrixXd x = Eigen::MatrixXd::Random(p, 2);  // fixed seed: Eigen's default rand()
+  Eigen::MatrixXd long_x(p * repeats, 2);
+  for (Eigen::Index r = 0; r < repeats; ++r) long_x.middleRows(r * p, p) = x;
+  const Eigen::MatrixXd expected = filtfilt(f, long_x).middleRows(5 * p, p);
+  const Eigen::MatrixXd y = filtfilt_periodic(f, x);
+  EXPECT_LT((y - expected).cwiseAbs().maxCoeff(), 1e-10);
+}
+
+TEST(PeriodicLowpass, DecimationThatBreaksThePeriodOrAliasesIsAnError) {
+  PeriodicLowpassOptions o;
+  o.design = seed2_chebyshev();
+  const Eigen::MatrixXd x = Eigen::MatrixXd::Ones(2000, 1);
+  o.decimate = 3;
+  try {
+    lowpass_periodic(o, x);
+    ADD_FAILURE() << "no error for a factor that does not divide the period";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "decimation by 3 does not divide the period's 2000 samples: the kept samples would "
+              "not be evenly spaced across the period's wrap; use a factor that divides it (2, 4, "
+              "5, 8, 10, 16, 20, 25, 40, 50)");
+  }
+  o.decimate = 10;  // new Nyquist 50 Hz, below the 80 Hz cut-off
+  try {
+    lowpass_periodic(o, x);
+    ADD_FAILURE() << "no error for an aliasing decimation";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "cut-off 80 Hz is not below the decimated Nyquist rate 50 Hz (rate 1000 Hz / (2 x "
+              "10)): the decimation would alias; lower the cut-off or the decimation factor");
+  }
+  EXPECT_THROW(filtfilt_periodic(design_lowpass(o.design), Eigen::MatrixXd::Constant(10, 1, NAN)),
+               Error);
 }
 
 }  // namespace

@@ -54,11 +54,22 @@ EquationBlock project_equations(const EquationBlock& block, const SignalProjecto
 /// (WLS: 1/σ_g per joint from group_variance; OLS, RLS: 1); Student-t intervals with Σ d − rank
 /// degrees of freedom. `effective_rows` = Σ over runs and joints of the projector's rank. The
 /// correlated-residual warning of the estimate stage is dropped (projected residuals are smooth
-/// by construction). Returns the one-line covariance choice. Throws dynid::Error when
-/// effective_rows ≤ the parameters.
+/// by construction).
+/// `channel` (per row, e.g. run·n + joint; empty = none): model error shows as channels that
+/// disagree about a parameter beyond their noise (seed 2's one-joint runs: a held joint's friction
+/// in its gravity rows), which the white σ² above, pooled over all channels, does not see. The
+/// channel-clustered sandwich C_cl = B·(Σ_c g_c g_cᵀ)·B·G/(G−1)·(N−1)/(N−K) (B = (W̃_wᵀW̃_w)⁻¹,
+/// g_c = W̃_cᵀẽ_c, G channels, N = effective_rows, K = rank; Liang–Zeger 1986, CR1) measures that
+/// disagreement; with few channels it is unreliable on its own, so each parameter's variance is
+/// the larger of the two (Angrist–Pischke 2009 §8.2.3), with the white correlations
+/// (C = S·C_white·S, S = diag(max(1, σ_cl/σ_white))): PSD, never narrower than the white one.
+/// Parameters widened by more than 20 % are named in a warning. docs/methods/projection.md.
+/// Returns the one-line covariance choice. Throws dynid::Error when effective_rows ≤ the
+/// parameters or `channel` has the wrong size.
 std::string projected_statistics(Estimate& estimate, const EquationBlock& block,
                                  Eigen::Index effective_rows, bool weighted,
-                                 const EstimationOptions& options);
+                                 const EstimationOptions& options,
+                                 const Eigen::VectorXi& channel = Eigen::VectorXi());
 
 /// Refuses what identify() cannot do with options.closed_loop: another model than the
 /// differential one, or not one reference per run (none needed without a
