@@ -135,7 +135,7 @@ nlohmann::json one_run(const ClosedLoopReport& r) {
     j["method"] = "spectral";
     j["M1"] = 0;
     j["M2"] = 0;
-    j["correlation"] = nlohmann::json::array();
+    j["correlation"] = vector_json(r.correlation);
     j["spectrum"] = {{"f0_hz", json_number(s.f0_hz)},
                      {"period_samples", s.period_samples},
                      {"periods", s.periods},

@@ -81,6 +81,9 @@ TEST(ClosedLoopCli, ProjectionSpectralAndRepeatWriteTheirJson) {
   EXPECT_NEAR(j["closed_loop"]["spectrum"]["f0_hz"].get<double>(), 0.2, 1e-9);
   EXPECT_EQ(j["closed_loop"]["spectrum"]["lines"], nlohmann::json({1, 2, 3, 4}));
   EXPECT_EQ(j["closed_loop"]["dimensions_per_channel"], 9);
+  // The lines kept and the rest of the spectrum are orthogonal: corr(û, ũ) is round-off, per joint.
+  ASSERT_EQ(j["closed_loop"]["correlation"].size(), 2u);
+  for (const auto& c : j["closed_loop"]["correlation"]) EXPECT_LT(std::abs(c.get<double>()), 1e-9);
   // validate says that a closed-loop result is checked against the measured, unprojected torques.
   r = run("validate --robot planar2 --params " + path("spectral.json") + " --data " + data +
           " --json " + path("validate_spectral.json"));
