@@ -29,18 +29,6 @@ struct AverageCliOptions {
   int decimate = 1;             // --decimate
 };
 
-// The reference a controller followed is its own noise-free command, not a measurement: its
-// analytic derivatives (dqr*, ddqr*) must stay its derivatives, so the filter leaves it alone.
-bool is_reference_column(const std::string& name) {
-  for (const char* prefix : {"qr", "dqr", "ddqr"}) {
-    const std::string p = prefix;
-    if (name.size() > p.size() && name.compare(0, p.size(), p) == 0 &&
-        name.find_first_not_of("0123456789", p.size()) == std::string::npos)
-      return true;
-  }
-  return false;
-}
-
 void run(const AverageCliOptions& o) {
   if ((o.period > 0.0) == (o.f0 > 0.0))
     throw UsageError("give exactly one of --period S or --f0 HZ (> 0)");
@@ -81,6 +69,7 @@ void run(const AverageCliOptions& o) {
   options.start = o.start;
   options.skip_periods = o.skip_periods;
   const TimedPeriodAverage a = average_periods_in_time(table.data.col(t_col), x, period, options);
+  const std::vector<std::string> warnings = check_period_repeats(a, x, names);
 
   // Seed 2 section 3.4: averaged, then low-passed (8th-order Chebyshev at 80 Hz) and resampled
   // (200 Hz). The mean is one period of a periodic signal, so the zero-phase filter is circular:
@@ -95,7 +84,7 @@ void run(const AverageCliOptions& o) {
   lowpass.decimate = o.decimate;
   std::vector<Eigen::Index> measured;  // columns filtered (every one but the reference's)
   for (Eigen::Index c = 0; c < a.mean.cols(); ++c)
-    if (!is_reference_column(names[static_cast<size_t>(c)])) measured.push_back(c);
+    if (!is_reference_channel(names[static_cast<size_t>(c)])) measured.push_back(c);
   Eigen::MatrixXd kept = a.mean;
   Eigen::VectorXd phase = a.phase;
   if (filtered) {
@@ -129,10 +118,11 @@ void run(const AverageCliOptions& o) {
     j["samples_after"] = a.samples_after;
     j["partial_period"] = a.partial_period;
     j["residual_samples"] = a.residual_samples;
+    j["warnings"] = warnings;
     if (filtered) {
       nlohmann::json unfiltered = nlohmann::json::array();
       for (const std::string& name : names)
-        if (is_reference_column(name)) unfiltered.push_back(name);
+        if (is_reference_channel(name)) unfiltered.push_back(name);
       j["filter"] = {
           {"family", filter.family == LowpassFamily::kChebyshev1 ? "chebyshev" : "butterworth"},
           {"order", filter.order},
@@ -154,6 +144,7 @@ void run(const AverageCliOptions& o) {
                                {"normality_p", json_number(ch.normality_p)}});
     }
   }
+  for (const std::string& w : warnings) std::cerr << "warning: " << w << '\n';
   write_csv(o.out, header, mean);
   if (!o.json.empty()) write_json(o.json, j);
   std::cout << "averaged " << a.periods << " periods of " << short_number(period) << " s ("

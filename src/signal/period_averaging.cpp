@@ -282,4 +282,62 @@ TimedPeriodAverage average_periods_in_time(const Eigen::Ref<const Eigen::VectorX
   return out;
 }
 
+namespace {
+
+bool has_index_suffix(const std::string& name, const std::string& prefix) {
+  return name.size() > prefix.size() && name.compare(0, prefix.size(), prefix) == 0 &&
+         name.find_first_not_of("0123456789", prefix.size()) == std::string::npos;
+}
+
+// A noise-free reference repeats to its interpolation error (about 1e-4 of its range for a
+// period that is not a whole number of samples); a wrong period spreads it by tens of percent.
+constexpr double kReferenceSpread = 0.01;
+// A measured position's noise is far below its motion in any identification run.
+constexpr double kPositionSpread = 0.1;
+
+}  // namespace
+
+bool is_reference_channel(const std::string& name) {
+  for (const char* prefix : {"qr", "dqr", "ddqr"})
+    if (has_index_suffix(name, prefix)) return true;
+  return false;
+}
+
+std::vector<std::string> check_period_repeats(const TimedPeriodAverage& a,
+                                              const Eigen::Ref<const Eigen::MatrixXd>& x,
+                                              const std::vector<std::string>& names) {
+  if (x.cols() != static_cast<Eigen::Index>(names.size()) || a.channels.size() != names.size() ||
+      x.rows() < 2)
+    throw Error("check_period_repeats: sizes of the data, names and average do not match");
+  const double period = a.samples_per_period * a.sample_time;
+  std::vector<std::string> warnings;
+  for (std::size_t c = 0; c < names.size(); ++c) {
+    const auto col = x.col(static_cast<Eigen::Index>(c));
+    const double range = col.maxCoeff() - col.minCoeff();
+    if (!(range > 0.0)) continue;  // a held joint repeats with any period
+    const double spread = a.channels[c].std / range;
+    if (is_reference_channel(names[c]) && spread > kReferenceSpread) {
+      std::string own;
+      try {
+        own = "; its own period is " + short_number(detect_period(col) * a.sample_time) +
+              " s (autocorrelation)";
+      } catch (const Error&) {
+        own = "; no period found in it (is it periodic?)";
+      }
+      throw Error("the reference " + names[c] + " does not repeat with the period " +
+                  short_number(period) + " s: its periods differ by " +
+                  short_number(100.0 * spread) +
+                  " % of its range (a noise-free reference "
+                  "repeats to its interpolation error)" +
+                  own + "; check --period/--f0");
+    }
+    if (has_index_suffix(names[c], "q") && spread > kPositionSpread)
+      warnings.push_back(names[c] + " spreads by " + short_number(100.0 * spread) +
+                         " % of its range across the periods of " + short_number(period) +
+                         " s: the noise statistics and the mean period are doubtful (noise, "
+                         "drift, or not the period of the run: check --period/--f0)");
+  }
+  return warnings;
+}
+
 }  // namespace dynid

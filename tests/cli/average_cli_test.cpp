@@ -83,6 +83,20 @@ TEST_F(AverageCli, APeriodWithoutTwoPeriodsIsOneErrorLineAndNothingWritten) {
   EXPECT_EQ(u.err, "error: give exactly one of --period S or --f0 HZ (> 0)\n");
 }
 
+// A period that is not the run's averages unrelated samples: the noise-free reference shows it,
+// so it is one error line with the reference's own period, not a mean and noise written.
+TEST_F(AverageCli, APeriodTheReferenceDoesNotRepeatWithIsOneErrorLine) {
+  const auto r = run("average --data " + work("run.csv") + " --period 0.5 --out " +
+                     work("avg.csv") + " --json " + work("noise.json"));
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(r.err.rfind("error: the reference qr1 does not repeat with the period 0.5 s", 0), 0u)
+      << r.err;
+  EXPECT_NE(r.err.find("its own period is 0.75"), std::string::npos) << r.err;  // to a sample
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(work("avg.csv")));
+  EXPECT_FALSE(fs::exists(work("noise.json")));
+}
+
 // Seed 2's chain (25 periods averaged, Chebyshev 8 at 80 Hz, 200 Hz) through the binary: three
 // 2 s periods at 1 kHz of q1 = an in-band line (0.5 Hz) plus a 150 Hz tone, and its noise-free
 // reference qr1. The averaged period comes out at 200 Hz (400 rows) with the line scaled by the

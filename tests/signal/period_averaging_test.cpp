@@ -2,6 +2,7 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <Eigen/Dense>
@@ -89,6 +90,36 @@ TEST(DetectPeriod, FindsFundamentalNotMultiple) {
   Eigen::VectorXd z(1000);
   for (Eigen::Index i = 0; i < z.size(); ++i) z(i) = static_cast<double>((i % 40) < 10);
   EXPECT_EQ(detect_period(z), 40);
+}
+
+// check_period_repeats: 6 periods of 1 s at 100 Hz of a noise-free reference qr1 and a measured
+// q1 = qr1 + N(0, 0.01²). The right period passes silently; a wrong one is an error naming qr1
+// and the period its autocorrelation shows; without the reference, a wrong period is a warning on
+// q1 (its spread is the signal's own variation, not noise).
+TEST(CheckPeriodRepeats, RightPeriodPassesWrongOneIsNamed) {
+  const int m = 600;
+  Eigen::VectorXd t(m);
+  Eigen::MatrixXd x(m, 2);
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> g(0.0, 0.01);
+  for (int k = 0; k < m; ++k) {
+    t[k] = k * 0.01;
+    x(k, 0) = std::sin(2 * kPi * t[k]) + 0.3 * std::cos(6 * kPi * t[k]);
+    x(k, 1) = x(k, 0) + g(rng);
+  }
+  const std::vector<std::string> names = {"qr1", "q1"};
+  EXPECT_TRUE(check_period_repeats(average_periods_in_time(t, x, 1.0), x, names).empty());
+  const TimedPeriodAverage wrong = average_periods_in_time(t, x, 0.7);
+  const std::string e = testing::error_of([&] { check_period_repeats(wrong, x, names); });
+  EXPECT_EQ(e.rfind("the reference qr1 does not repeat with the period 0.7 s", 0), 0u) << e;
+  EXPECT_NE(e.find("its own period is 1 s"), std::string::npos) << e;
+  const TimedPeriodAverage wrong_q = average_periods_in_time(t, x.rightCols(1), 0.7);
+  const auto w = check_period_repeats(wrong_q, x.rightCols(1), {"q1"});
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_EQ(w[0].rfind("q1 spreads by", 0), 0u) << w[0];
+  EXPECT_TRUE(is_reference_channel("ddqr12"));
+  EXPECT_FALSE(is_reference_channel("qr"));
+  EXPECT_FALSE(is_reference_channel("q1"));
 }
 
 TEST(PeriodErrors, Messages) {

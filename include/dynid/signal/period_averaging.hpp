@@ -1,6 +1,7 @@
 #pragma once
 
 #include <limits>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -98,6 +99,23 @@ TimedPeriodAverage average_periods_in_time(const Eigen::Ref<const Eigen::VectorX
                                            const Eigen::Ref<const Eigen::MatrixXd>& x,
                                            double period,
                                            const TimedPeriodAverageOptions& options = {});
+
+/// True for the name of a reference channel: qr<J>, dqr<J>, ddqr<J> (the controller's noise-free
+/// command and its analytic derivatives, as `dynid simulate` logs them).
+bool is_reference_channel(const std::string& name);
+
+/// Checks that a run repeats with the period it was averaged with (a wrong --period/--f0 averages
+/// unrelated samples and reports the signal's own variation as noise, a silently wrong result).
+/// `names` labels the columns of `x`, the data given to average_periods_in_time() with result `a`.
+/// A reference channel (is_reference_channel()) is noise-free: its spread across periods (its
+/// ChannelNoise::std) above 1 % of its range means the period is wrong; the error names the
+/// channel, the spread and the period detect_period() finds in it. A position channel (q<J>)
+/// spreading by more than 10 % of its range gives a returned warning (noise, drift or a wrong
+/// period: without a reference the run cannot tell which).
+/// Throws dynid::Error for a reference channel that does not repeat, or sizes that do not match.
+std::vector<std::string> check_period_repeats(const TimedPeriodAverage& a,
+                                              const Eigen::Ref<const Eigen::MatrixXd>& x,
+                                              const std::vector<std::string>& names);
 
 /// Result of a normality test.
 struct NormalityTest {
