@@ -108,8 +108,11 @@ CompletedModel complete_identified_model(
       nominal_share.head(e) = undetermined.rowwise().squaredNorm();
     } else {
       out.warnings.push_back(
-          "the result stores no covariance matrix (written by an older dynid): only the not "
-          "excited parameters were filled; badly determined ones are used as estimated");
+          std::string(covariance.size() == 0
+                          ? "the result stores no covariance matrix (written by an older dynid)"
+                          : "the result's covariance matrix is not finite") +
+          ": only the not excited parameters were filled; badly determined ones are used as "
+          "estimated");
     }
   }
   for (Eigen::Index i = 0; i < m; ++i) (nominal_share[i] > 0.5 ? bad : good).push_back(i);
