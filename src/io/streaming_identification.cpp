@@ -2,13 +2,12 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
-#include <condition_variable>
 #include <cstdint>
 #include <cstring>
 #include <exception>
-#include <filesystem>
-#include <mutex>
+#include <limits>
 #include <random>
 #include <thread>
 
@@ -25,10 +24,8 @@ namespace {
 // sign so that one-sided (asymmetric Coulomb) columns are seen as well.
 constexpr int kSparsityProbes = 8;
 constexpr unsigned kSparsitySeed = 20261123;
-// Upper bound on worker threads (each holds kQueueDepth chunks of text in memory).
+// Upper bound on worker threads.
 constexpr int kMaxThreads = 8;
-// Chunks queued per worker: enough to keep a worker busy while the reader serves the others.
-constexpr std::size_t kQueueDepth = 3;
 
 // Base columns (indices into base.base) that can be non-zero in each joint's torque row: the links
 // of the joint's subtree and the joint's own friction. Probed numerically at random states, since
@@ -60,7 +57,7 @@ std::vector<std::vector<Eigen::Index>> joint_base_columns(const Model& model,
   return columns;
 }
 
-// Everything one worker needs to turn a chunk of samples into accumulated rows.
+// Everything one worker needs to turn blocks of the file into accumulated rows.
 struct Worker {
   Worker(const Model& model, const ParameterLayout& layout, int rank,
          const StreamingOptions& lsq_options)
@@ -74,15 +71,10 @@ struct Worker {
   StreamingLeastSquares lsq;
   Eigen::MatrixXd Y;
   Eigen::VectorXd q, dq, ddq;
-  CsvChunkReader::RowBlock block;  // the chunk being processed, parsed by this worker
-  // Ring of chunks handed over by the reader, unparsed: [head, tail) are filled, in order.
-  std::mutex mutex;
-  std::condition_variable cv;
-  std::array<CsvTextChunk, kQueueDepth> chunks;
-  std::size_t head = 0, tail = 0;
-  bool done = false;
-  std::exception_ptr error;
-  Eigen::Index error_block = -1;
+  CsvBlock block;  // the block being processed, read and parsed by this worker
+  Eigen::Index samples = 0;
+  std::exception_ptr error;        // the worker's first error; it then stops
+  std::uint64_t error_offset = 0;  // file offset of the line it names (errors are ordered by it)
 };
 
 // The per-run constants shared read-only by the workers.
@@ -91,6 +83,7 @@ struct StreamSetup {
   const ParameterLayout* layout = nullptr;
   const BaseParameters* base = nullptr;
   std::string path;
+  std::size_t block_bytes = 0;
   std::vector<std::vector<Eigen::Index>> active;  // base columns per joint
   // The same as offsets into a worker's n-row regressor storage (regressor column·n + joint), and
   // the other base columns, checked to be zero: the per-sample gather and check read Y with one
@@ -100,10 +93,10 @@ struct StreamSetup {
   Eigen::VectorXd threshold;
 };
 
-void process_block(const StreamSetup& s, Worker& w, const CsvChunkReader::RowBlock& block,
-                   Eigen::Index first_row) {
+void process_block(const StreamSetup& s, const CsvBlockReader& reader, Worker& w) {
   const Model& model = *s.model;
   const int n = model.dof();
+  const CsvChunkReader::RowBlock& block = w.block.rows;
   for (Eigen::Index k = 0; k < block.rows(); ++k) {
     // The CSV reader has already refused NaN and Inf fields, naming the line.
     for (int j = 0; j < n; ++j) {
@@ -125,121 +118,87 @@ void process_block(const StreamSetup& s, Worker& w, const CsvChunkReader::RowBlo
         stray |= bits << 1;
       }
       if (stray != 0) {
+        w.block.error_offset = w.block.offsets[static_cast<std::size_t>(k)];
         throw Error("internal: the regressor of joint " + model.joints[j].name +
                     " is non-zero in a column probed as structurally zero (data row " +
-                    std::to_string(first_row + k + 1) + "); run without --stream and report it");
+                    std::to_string(reader.position(w.block.error_offset).row) +
+                    "); run without --stream and report it");
       }
       w.lsq.add_row_gathered(j, y, s.active_offset[j], block(k, s.ctau[j]));
     }
   }
 }
 
-// Reads the file once and accumulates every chunk; chunk k is processed by worker k mod W. The
-// reader thread only cuts lines; each worker parses its own chunks, so the parse runs on every
-// core instead of bounding the rate from one thread.
-// Returns the merged accumulator. The first error in file order is rethrown after all threads
-// have stopped, so no thread outlives the call. `progress` (may be empty) is told the fraction of
-// the file's bytes cut so far, from this (the calling) thread only, so that a caller's progress
-// line needs no lock.
+// Reads the file once and accumulates every block; block b (CsvBlockReader: a fixed byte range
+// of the file) is read, parsed and accumulated by worker b mod W, and the workers' sums are
+// merged in worker order, so the result depends on W but not on timing. There is no reader
+// thread: each worker reads its own text (pread) and parses it while it is in its core's cache,
+// as W independent processes would. The calling thread is worker 0 and the only one to call
+// `progress` (may be empty), with the fraction of the file's bytes done, so that a caller's
+// progress line needs no lock. The first error in file order is rethrown after every thread has
+// stopped, so no thread outlives the call.
 StreamingLeastSquares accumulate(const StreamSetup& s, const StreamingOptions& lsq_options,
                                  int threads, Eigen::Index& samples,
                                  const ProgressCallback& progress, const std::string& what) {
-  const int rank = s.base->rank;
-  // Bytes of the data lines cut so far (text plus one terminator each; the header and comments
-  // are not counted, so the fraction ends a little below 1) over the file size.
-  std::error_code size_error;
-  const auto file_bytes = std::filesystem::file_size(s.path, size_error);
-  double cut_bytes = 0.0;
-  const auto tell = [&](const CsvTextChunk& chunk) {
-    if (!progress || size_error || file_bytes == 0) return;
-    cut_bytes += static_cast<double>(chunk.text.size() + chunk.ends.size());
-    progress(std::min(1.0, cut_bytes / static_cast<double>(file_bytes)), what);
-  };
+  const CsvBlockReader reader(s.path, {s.block_bytes});
+  const std::int64_t blocks = reader.blocks();
+  const int workers_used = static_cast<int>(std::min<std::int64_t>(threads, blocks));
   std::vector<std::unique_ptr<Worker>> workers;
-  for (int t = 0; t < threads; ++t) {
-    workers.push_back(std::make_unique<Worker>(*s.model, *s.layout, rank, lsq_options));
+  for (int t = 0; t < workers_used; ++t) {
+    workers.push_back(std::make_unique<Worker>(*s.model, *s.layout, s.base->rank, lsq_options));
   }
-  CsvChunkReader reader(s.path);
-  samples = 0;
-  if (threads == 1) {
-    Worker& w = *workers[0];
-    while (reader.next_text(w.chunks[0])) {
-      tell(w.chunks[0]);
-      reader.parse_text(w.chunks[0], w.block);
-      process_block(s, w, w.block, samples);
-      samples += w.block.rows();
-    }
-    return std::move(w.lsq);
-  }
-
-  std::vector<std::thread> pool;
-  for (int t = 0; t < threads; ++t) {
-    pool.emplace_back([&s, &reader, &w = *workers[t], t, threads] {
-      for (Eigen::Index index = t;; index += threads) {
-        std::unique_lock<std::mutex> lock(w.mutex);
-        w.cv.wait(lock, [&w] { return w.head != w.tail || w.done; });
-        if (w.head == w.tail) return;
-        const CsvTextChunk& chunk = w.chunks[w.head % kQueueDepth];
-        const bool failed = static_cast<bool>(w.error);
-        lock.unlock();  // the reader only touches other slots while this one is in use
-        if (!failed) {
-          try {
-            reader.parse_text(chunk, w.block);
-            process_block(s, w, w.block, chunk.first_row);
-          } catch (...) {
-            lock.lock();
-            w.error = std::current_exception();
-            w.error_block = index;
-            lock.unlock();
-          }
+  // Bytes of the blocks done (the header counted from the start, so that the fraction ends at 1).
+  std::atomic<std::uint64_t> done{reader.block_begin(0)};
+  // Offset of the earliest failing line known so far: a block that starts after it cannot hold
+  // the first error and is skipped.
+  std::atomic<std::uint64_t> first_error{std::numeric_limits<std::uint64_t>::max()};
+  const double file_bytes = static_cast<double>(reader.file_bytes());
+  const auto tell = [&] {
+    if (progress && file_bytes > 0) progress(static_cast<double>(done.load()) / file_bytes, what);
+  };
+  const auto run = [&](int t) {
+    Worker& w = *workers[static_cast<std::size_t>(t)];
+    for (std::int64_t b = t; b < blocks; b += workers_used) {
+      if (reader.block_begin(b) > first_error.load(std::memory_order_relaxed)) return;
+      try {
+        reader.parse(b, w.block);
+        process_block(s, reader, w);
+      } catch (...) {
+        w.error = std::current_exception();
+        w.error_offset = w.block.error_offset;
+        std::uint64_t seen = first_error.load();
+        while (w.error_offset < seen && !first_error.compare_exchange_weak(seen, w.error_offset)) {
         }
-        lock.lock();
-        ++w.head;
-        lock.unlock();
-        w.cv.notify_all();
+        return;
       }
-    });
-  }
-  std::exception_ptr reader_error;
-  Eigen::Index index = 0;
+      w.samples += w.block.rows.rows();
+      done += reader.block_begin(b + 1) - reader.block_begin(b);
+      if (t == 0) tell();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < workers_used; ++t) pool.emplace_back(run, t);
+  std::exception_ptr caller_error;  // from the progress callback: stop the others, then rethrow
   try {
-    CsvTextChunk chunk;
-    while (reader.next_text(chunk)) {
-      tell(chunk);
-      Worker& w = *workers[index % threads];
-      std::unique_lock<std::mutex> lock(w.mutex);
-      w.cv.wait(lock, [&w] { return w.tail - w.head < kQueueDepth; });
-      if (w.error) break;
-      const Eigen::Index rows = chunk.rows();
-      std::swap(w.chunks[w.tail % kQueueDepth], chunk);  // both keep their storage
-      ++w.tail;
-      lock.unlock();
-      w.cv.notify_all();
-      samples += rows;
-      ++index;
-    }
+    run(0);
   } catch (...) {
-    reader_error = std::current_exception();
-  }
-  for (auto& w : workers) {
-    {
-      std::lock_guard<std::mutex> lock(w->mutex);
-      w->done = true;
-    }
-    w->cv.notify_all();
+    caller_error = std::current_exception();
+    first_error = 0;
   }
   for (auto& t : pool) t.join();
-  // The earliest failing chunk decides which error the user sees.
-  std::exception_ptr first = reader_error;
-  Eigen::Index first_block = reader_error ? index : -1;
-  for (auto& w : workers) {
-    if (w->error && (first_block < 0 || w->error_block < first_block)) {
-      first = w->error;
-      first_block = w->error_block;
+  if (caller_error) std::rethrow_exception(caller_error);
+  const Worker* failed = nullptr;
+  for (const auto& w : workers) {
+    if (w->error && (failed == nullptr || w->error_offset < failed->error_offset)) {
+      failed = w.get();
     }
   }
-  if (first) std::rethrow_exception(first);
-  for (int t = 1; t < threads; ++t) workers[0]->lsq.merge(workers[t]->lsq);
+  if (failed != nullptr) std::rethrow_exception(failed->error);
+  // Worker 0 may have finished its share before the others: the fraction ends at 1.
+  if (workers_used > 1) tell();
+  samples = 0;
+  for (const auto& w : workers) samples += w->samples;
+  for (int t = 1; t < workers_used; ++t) workers[0]->lsq.merge(workers[t]->lsq);
   return std::move(workers[0]->lsq);
 }
 
@@ -309,6 +268,7 @@ IdentificationResult identify_stream(const Model& model, const std::string& path
   s.layout = &options.layout;
   s.base = &result.base;
   s.path = path;
+  s.block_bytes = stream.block_bytes;
   {
     CsvChunkReader header(path);
     std::vector<std::string> columns = header.columns();
@@ -382,7 +342,9 @@ IdentificationResult identify_stream(const Model& model, const std::string& path
   result.choices.emplace_back("mode",
                               "streaming (constant memory), no filtering, dq and ddq as given");
   result.choices.emplace_back("accumulation", accumulation);
-  result.choices.emplace_back("threads", std::to_string(threads) + " workers + 1 reader");
+  result.choices.emplace_back("threads", std::to_string(threads) +
+                                             " workers, each reading and parsing its own blocks of "
+                                             "the file");
   result.zero_velocity_threshold = s.threshold;
   result.choices.emplace_back("covariance",
                               "white-noise sigma^2 (W^T W)^-1 (the stream keeps no residual "

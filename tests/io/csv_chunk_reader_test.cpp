@@ -195,5 +195,162 @@ TEST(CsvChunkReader, TextChunksParsedOnOtherThreadsEqualTheWholeFile) {
   EXPECT_HAS(error_of([&] { alone.next_text(chunk); }), "order.csv:5: line is longer than");
 }
 
+// Issue 16: CsvBlockReader cuts the file into byte blocks parsed by several threads at once.
+// Parses every block, block b on thread b mod `threads`, and concatenates the rows in block order.
+struct BlockRead {
+  Eigen::MatrixXd rows;
+  std::vector<std::uint64_t> offsets;
+};
+BlockRead read_blocks(const std::string& path, std::size_t block_bytes, int threads) {
+  const CsvBlockReader reader(path, {block_bytes});
+  std::vector<CsvBlock> blocks(static_cast<std::size_t>(reader.blocks()));
+  std::vector<std::thread> pool;
+  for (int t = 0; t < threads; ++t) {
+    pool.emplace_back([&, t] {
+      for (std::size_t b = t; b < blocks.size(); b += threads) reader.parse(b, blocks[b]);
+    });
+  }
+  for (auto& t : pool) t.join();
+  BlockRead all;
+  all.rows.resize(0, static_cast<Eigen::Index>(reader.columns().size()));
+  for (const CsvBlock& block : blocks) {
+    all.rows.conservativeResize(all.rows.rows() + block.rows.rows(), Eigen::NoChange);
+    all.rows.bottomRows(block.rows.rows()) = block.rows;
+    all.offsets.insert(all.offsets.end(), block.offsets.begin(), block.offsets.end());
+  }
+  return all;
+}
+
+// Oracle: read_csv of the same file. Block sizes from 1 byte (most blocks hold no line start) to
+// larger than the file, with a line exactly on a block boundary, CRLF and CR-only line ends,
+// comments and blank lines before the header and in the middle, no final newline; 1-3 threads.
+TEST(CsvBlockReader, BlocksInAnyThreadCountConcatenateToReadCsv) {
+  TempDir dir;
+  std::mt19937 rng(161);
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd data(150, 4);
+  for (Eigen::Index i = 0; i < data.size(); ++i) data.data()[i] = normal(rng);
+  std::string lf = "# comment\n" + format_csv({"t", "q1", "dq1", "tau1"}, data);
+  lf.insert(lf.find('\n', 3000) + 1, "# mid comment\n\n  \n");
+  lf.pop_back();  // no final newline
+  std::string crlf, cr;
+  for (char c : lf) {
+    crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+    cr += c == '\n' ? '\r' : c;
+  }
+  // Lines of 16 bytes after a 5-byte header: blocks of 16 bytes start exactly on a line.
+  std::string fixed = "t,q1\n";
+  Eigen::MatrixXd fixed_data(40, 2);
+  for (int k = 0; k < 40; ++k) {
+    char line[32];
+    std::snprintf(line, sizeof line, "%07d,%07d\n", k, 2 * k);
+    fixed += line;
+    fixed_data.row(k) << k, 2 * k;
+  }
+  struct Case {
+    std::string name, text;
+    std::vector<std::size_t> block_bytes;
+  };
+  const std::vector<Case> cases = {{"lf.csv", lf, {1, 2, 7, 97, 1000, 1 << 20}},
+                                   {"crlf.csv", crlf, {1, 3, 61, 4096}},
+                                   {"cr.csv", cr, {1, 5, 333}},
+                                   {"fixed.csv", fixed, {1, 8, 15, 16, 17, 32}}};
+  for (const Case& c : cases) {
+    const std::string path = dir.write(c.name, c.text);
+    const CsvTable whole = read_csv(path);
+    ASSERT_EQ(whole.data, c.name == "fixed.csv" ? fixed_data : data) << c.name;
+    for (const std::size_t bytes : c.block_bytes) {
+      for (int threads = 1; threads <= 3; ++threads) {
+        const BlockRead r = read_blocks(path, bytes, threads);
+        ASSERT_EQ(r.rows, whole.data) << c.name << " " << bytes << " bytes " << threads;
+        // Each row's offset is the start of its line: after a line end.
+        ASSERT_EQ(r.offsets.size(), static_cast<std::size_t>(whole.rows()));
+        for (std::size_t k = 0; k < r.offsets.size(); ++k) {
+          ASSERT_TRUE(c.text[r.offsets[k] - 1] == (c.name == "cr.csv" ? '\r' : '\n'))
+              << c.name << " row " << k;
+        }
+      }
+    }
+  }
+  const CsvBlockReader reader(dir.file("fixed.csv"), {16});
+  EXPECT_EQ(reader.columns(), (std::vector<std::string>{"t", "q1"}));
+  EXPECT_EQ(reader.blocks(), 40);
+  EXPECT_EQ(reader.block_begin(0), 5u);
+  EXPECT_EQ(reader.block_begin(40), reader.file_bytes());
+  EXPECT_EQ(reader.position(5 + 16 * 7).line, 9);  // header on line 1, data row 8
+  EXPECT_EQ(reader.position(5 + 16 * 7).row, 8);
+}
+
+// The first error of a sequential read over the blocks is CsvChunkReader's, word for word,
+// wherever the faulty line lies: the first data line, a line in the middle (after comments), a
+// truncated last line, an over-long line; block.error_offset is the start of that line.
+TEST(CsvBlockReader, ErrorsNameTheLineInEveryBlockPosition) {
+  TempDir dir;
+  std::string good = "# c\na,b\n";
+  for (int k = 0; k < 60; ++k) {
+    good += std::to_string(k) + ".25,-" + std::to_string(3 * k) + ".5\n";
+    if (k == 20) good += "# mid\n\n";
+  }
+  const auto line_start = [&](const std::string& text, int line) {
+    std::size_t pos = 0;
+    for (int l = 1; l < line; ++l) pos = text.find('\n', pos) + 1;
+    return pos;
+  };
+  const auto replace_line = [&](int line, const std::string& with, std::string text = {}) {
+    if (text.empty()) text = good;
+    const std::size_t b = line_start(text, line);
+    text.replace(b, text.find('\n', b) - b, with);
+    return text;
+  };
+  std::string truncated = good;
+  truncated.resize(truncated.size() - 8);  // "59.25,-177.5\n" cut to "59.25"
+  std::string crlf_bad;
+  for (char c : replace_line(40, "1,2,3"))
+    crlf_bad += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {"first.csv", replace_line(3, "0.25,x")},
+      {"middle.csv", replace_line(37, "nan,1")},
+      {"crlf.csv", crlf_bad},
+      {"last.csv", truncated},
+      {"long.csv", replace_line(50, std::string(kMaxCsvLineBytes + 1, '1'))},
+      {"two.csv", replace_line(45, "1,,2", replace_line(12, "1;2"))}};
+  for (const auto& [name, text] : files) {
+    const std::string path = dir.write(name, text);
+    CsvChunkReader sequential(path, {7, 1 << 20});
+    Eigen::MatrixXd rows;
+    const std::string expected = error_of([&] {
+      while (sequential.next(rows)) {
+      }
+    });
+    EXPECT_HAS(expected, name + ":");
+    for (const std::size_t bytes :
+         {std::size_t{1}, std::size_t{13}, std::size_t{200}, std::size_t{1} << 21}) {
+      const CsvBlockReader reader(path, {bytes});
+      CsvBlock block;
+      std::string message;
+      for (std::int64_t b = 0; b < reader.blocks() && message.empty(); ++b) {
+        try {
+          reader.parse(b, block);
+        } catch (const Error& e) {
+          message = e.what();
+          const std::uint64_t at = block.error_offset;
+          EXPECT_TRUE(at == reader.block_begin(0) || text[at - 1] == '\n') << name << " " << at;
+          EXPECT_EQ(reader.position(at).line,
+                    1 + std::count(text.begin(), text.begin() + at, '\n'));
+        }
+      }
+      EXPECT_EQ(message, expected) << name << ", blocks of " << bytes << " bytes";
+    }
+  }
+  const std::string header_only = dir.write("h.csv", "a,b\n# only\n");
+  EXPECT_EQ(error_of([&] { CsvBlockReader r(header_only); }), error_of([&] {
+              CsvChunkReader r(header_only);
+              Eigen::MatrixXd rows;
+              r.next(rows);
+            }));
+  EXPECT_HAS(error_of([&] { CsvBlockReader r(dir.write("z.csv", "a,b\n1,2\n"), {0}); }),
+             "block_bytes is 0");
+}
+
 }  // namespace
 }  // namespace dynid

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <cstdio>
 #include <functional>
 #include <memory>
@@ -75,6 +76,80 @@ class CsvChunkReader {
   // Parses chunk row k, field c into out[k·row_step + c·column_step].
   void parse_into(const CsvTextChunk& chunk, double* out, Eigen::Index row_step,
                   Eigen::Index column_step) const;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  friend class CsvBlockReader;  // reads the header with this class's rules and keeps its offset
+};
+
+/// Options of CsvBlockReader.
+struct CsvBlockOptions {
+  /// Bytes of the file per block (> 0). About a core's L2 cache, so that the thread that reads a
+  /// block parses text still in its own cache.
+  std::size_t block_bytes = std::size_t{256} << 10;
+};
+
+/// A block parsed by CsvBlockReader::parse, and the parsing thread's scratch (storage is reused).
+struct CsvBlock {
+  CsvChunkReader::RowBlock rows;       ///< data rows × columns, a sample's fields contiguous
+  std::vector<std::uint64_t> offsets;  ///< offsets[k]: file byte offset where row k's line starts
+  /// After parse threw: the byte offset of the failing line (for ordering errors across blocks).
+  std::uint64_t error_offset = 0;
+  std::vector<char> text;  ///< scratch: the block's bytes and the rest of its last line
+  struct Line {
+    std::size_t begin, end;  // in text, without the terminator (and CR)
+    bool data;               // not blank, not a comment
+    bool terminated;         // false only for the file's last line without a final newline
+  };
+  std::vector<Line> lines;  ///< scratch: every line starting in the block
+};
+
+/// 1-based file line and data row (comments and blank lines not counted) of a line.
+struct CsvPosition {
+  long line = 0;  ///< file line
+  long row = 0;   ///< data row
+};
+
+/// Random-access CSV reader for parallel parsing (identify_stream): the bytes after the header are
+/// cut into blocks of options.block_bytes, and block b holds the lines that START in it (it reads
+/// past its end to finish the last one), so blocks 0, 1, … concatenated give read_csv's rows for
+/// any block size. parse() may be called from several threads at once, each with its own CsvBlock
+/// (pread on one descriptor): each thread reads and parses its own text. Same format and errors as
+/// CsvChunkReader; since a block does not know its first line number, the number in a message is
+/// found when a line fails, by counting the line ends before it (an error costs a read of the file
+/// up to the failing line). Regular files only. Memory: one block (plus one line) per thread.
+class CsvBlockReader {
+ public:
+  /// Opens `path` and reads its header. Throws dynid::Error as CsvChunkReader does, for a file
+  /// with a header but no data rows, for a file that is not a regular file and for a block size
+  /// of 0.
+  explicit CsvBlockReader(const std::string& path, const CsvBlockOptions& options = {});
+  ~CsvBlockReader();
+  CsvBlockReader(const CsvBlockReader&) = delete;
+  CsvBlockReader& operator=(const CsvBlockReader&) = delete;
+
+  /// Header names in file order.
+  const std::vector<std::string>& columns() const;
+  /// Number of blocks (≥ 1).
+  std::int64_t blocks() const;
+  /// File byte offset of block b's first byte (b in [0, blocks()]; blocks() gives the file size).
+  std::uint64_t block_begin(std::int64_t b) const;
+  /// File size in bytes.
+  std::uint64_t file_bytes() const;
+
+  /// Reads and parses block b (0 ≤ b < blocks()) into block.rows and block.offsets (possibly no
+  /// rows: a block inside one long line). Throws dynid::Error for malformed rows and over-long
+  /// lines (file, line, column, fix) and for read errors; block.error_offset then holds the start
+  /// of the failing line.
+  void parse(std::int64_t b, CsvBlock& block) const;
+
+  /// Line and data row of the line starting at byte `offset` (a value of CsvBlock::offsets or
+  /// error_offset), by counting the lines before it: for messages, not for a hot path.
+  CsvPosition position(std::uint64_t offset) const;
+
+ private:
+  // Cuts the lines of block b that start before `stop` into block.lines (block.text holds them).
+  // Throws for over-long lines and read errors, with block.error_offset set.
+  void cut(std::int64_t b, CsvBlock& block, std::uint64_t stop) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
