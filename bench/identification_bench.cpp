@@ -64,7 +64,8 @@ void BM_IdentifyStream(benchmark::State& st) {
   const std::string path = run_file(model, samples);
   dynid::IdentifyOptions o;
   o.signal.filter = false;
-  const dynid::StreamingIdentificationOptions so{static_cast<int>(st.range(1)), st.range(2) != 0};
+  const dynid::StreamingIdentificationOptions so{static_cast<int>(st.range(1)), st.range(2) != 0,
+                                                 static_cast<std::size_t>(st.range(3)) << 10};
   for (auto _ : st) {
     const auto r = dynid::identify_stream(model, path, {}, o, so);
     benchmark::DoNotOptimize(r.estimate.x.data());
@@ -79,14 +80,18 @@ void BM_IdentifyStream(benchmark::State& st) {
 
 }  // namespace
 
-// Arguments: samples, worker threads, normal equations (1) or Householder (0) accumulation.
+// Arguments: samples, worker threads, normal equations (1) or Householder (0) accumulation, KiB
+// of the file per block (StreamingIdentificationOptions::block_bytes; 256 is the default).
 BENCHMARK(BM_IdentifyStream)
-    ->ArgNames({"samples", "threads", "normal_equations"})
-    ->Args({100000, 1, 0})
-    ->Args({100000, 1, 1})
-    ->Args({100000, 2, 1})
-    ->Args({1000000, 1, 1})
-    ->Args({1000000, 2, 1})
+    ->ArgNames({"samples", "threads", "normal_equations", "block_KiB"})
+    ->Args({100000, 1, 0, 256})
+    ->Args({100000, 1, 1, 256})
+    ->Args({100000, 2, 1, 256})
+    ->Args({1000000, 1, 1, 256})
+    ->Args({1000000, 2, 1, 256})
+    ->Args({1000000, 2, 1, 64})
+    ->Args({1000000, 2, 1, 1024})
+    ->MeasureProcessCPUTime()
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1);

@@ -2,11 +2,10 @@
 // on the whole `dynid identify --stream` gives the shares, docs/performance.md): the per-sample
 // stages of `dynid identify --stream` for the 7-DoF iiwa14, full layout (98 columns, 69 base), each
 // timed alone on the same 4096 samples (one chunk):
-//   CsvCut        CsvChunkReader::next_text on the file of those samples (the reader thread's
-//                 share: open, read, split lines; the reader is built per iteration, so its
-//                 buffers' page faults are counted once per 4096 samples instead of once per run)
+//   CsvBlocks     CsvBlockReader::parse of every block of the file of those samples, as one
+//                 worker of identify_stream does (pread, cut lines, parse into a row-major block)
 //   CsvParse      CsvChunkReader::parse_text of the 29-column text (t, q, dq, ddq, tau) into a
-//                 row-major block, as the workers do
+//                 row-major block: the parse alone, of text already in memory
 //   Regressor     torque_regressor, one call per sample
 //   Accumulate    per joint: StreamingLeastSquares::add_row_gathered of its base columns out of
 //                 the regressor's storage, normal equations, per-joint column subsets (as
@@ -89,12 +88,15 @@ const Run& run() {
   return r;
 }
 
-void BM_StageCsvCut(benchmark::State& st) {
+void BM_StageCsvBlocks(benchmark::State& st) {
   const Run& r = run();
-  dynid::CsvTextChunk chunk;
+  const dynid::CsvBlockReader reader(r.csv);
+  dynid::CsvBlock block;
   for (auto _ : st) {
-    dynid::CsvChunkReader reader(r.csv);
-    while (reader.next_text(chunk)) benchmark::DoNotOptimize(chunk.text.data());
+    for (std::int64_t b = 0; b < reader.blocks(); ++b) {
+      reader.parse(b, block);
+      benchmark::DoNotOptimize(block.rows.data());
+    }
   }
   st.counters["ns_per_sample"] = benchmark::Counter(
       kSamples * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
@@ -158,7 +160,7 @@ void BM_StageAccumulate(benchmark::State& st) {
 
 }  // namespace
 
-BENCHMARK(BM_StageCsvCut)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_StageCsvBlocks)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_StageCsvParse)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_StageRegressor)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_StageAccumulate)->Unit(benchmark::kMillisecond);
