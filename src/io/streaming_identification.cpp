@@ -177,9 +177,9 @@ StreamingLeastSquares accumulate(const StreamSetup& s, const StreamingOptions& l
     }
   };
   std::vector<std::thread> pool;
-  for (int t = 1; t < workers_used; ++t) pool.emplace_back(run, t);
-  std::exception_ptr caller_error;  // from the progress callback: stop the others, then rethrow
+  std::exception_ptr caller_error;  // thread creation or the progress callback: stop, rethrow
   try {
+    for (int t = 1; t < workers_used; ++t) pool.emplace_back(run, t);
     run(0);
   } catch (...) {
     caller_error = std::current_exception();
