@@ -1,6 +1,7 @@
 // libFuzzer harness for the CSV readers: the in-memory reader (parse_csv), the streaming reader
 // (CsvChunkReader, with a tiny buffer so that line and buffer boundaries are exercised) and the run
-// reader on top (read_joint_record for the built-in planar2). Both readers implement one format
+// reader on top (read_joint_record for the built-in planar2), and the block reader of
+// identify_stream (CsvBlockReader, blocks of a few bytes). All implement one format
 // (csv_reader.hpp), so they must accept the same inputs and return the same numbers.
 
 #include <cstdint>
@@ -30,26 +31,62 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
 
   const std::string path = fuzz::scratch_file(data, size, ".csv");
   bool stream_ok = false;
+  std::string stream_error;
   Eigen::MatrixXd streamed(0, 0);
   fuzz::expect_clean([&] {
-    CsvChunkOptions options;
-    options.chunk_rows = 3;
-    options.buffer_bytes = 16;
-    CsvChunkReader reader(path, options);
-    Eigen::MatrixXd block;
-    streamed.resize(0, static_cast<Eigen::Index>(reader.columns().size()));
-    while (reader.next(block)) {
-      Eigen::MatrixXd grown(streamed.rows() + block.rows(), streamed.cols());
-      grown << streamed, block;
-      streamed.swap(grown);
+    try {
+      CsvChunkOptions options;
+      options.chunk_rows = 3;
+      options.buffer_bytes = 16;
+      CsvChunkReader reader(path, options);
+      Eigen::MatrixXd block;
+      streamed.resize(0, static_cast<Eigen::Index>(reader.columns().size()));
+      while (reader.next(block)) {
+        Eigen::MatrixXd grown(streamed.rows() + block.rows(), streamed.cols());
+        grown << streamed, block;
+        streamed.swap(grown);
+      }
+      stream_ok = true;
+    } catch (const Error& e) {
+      stream_error = e.what();
+      throw;
     }
-    stream_ok = true;
   });
   fuzz::require(memory_ok == stream_ok, "parse_csv and CsvChunkReader accept the same files");
   if (memory_ok && stream_ok) {
     fuzz::require(streamed.rows() == table.data.rows() && streamed.cols() == table.data.cols() &&
                       (streamed.array() == table.data.array()).all(),
                   "parse_csv and CsvChunkReader return the same numbers");
+  }
+
+  // CsvBlockReader (identify_stream's parallel reader) with blocks of 1 to 7 bytes, so that lines
+  // start, end and cross block boundaries everywhere: the same files, numbers and first error.
+  bool blocks_ok = false;
+  std::string block_error;
+  Eigen::MatrixXd blocked(0, 0);
+  fuzz::expect_clean([&] {
+    try {
+      const CsvBlockReader reader(path, {1 + size % 7});
+      CsvBlock block;
+      blocked.resize(0, static_cast<Eigen::Index>(reader.columns().size()));
+      for (std::int64_t b = 0; b < reader.blocks(); ++b) {
+        reader.parse(b, block);
+        Eigen::MatrixXd grown(blocked.rows() + block.rows.rows(), blocked.cols());
+        grown << blocked, block.rows;
+        blocked.swap(grown);
+      }
+      blocks_ok = true;
+    } catch (const Error& e) {
+      block_error = e.what();
+      throw;
+    }
+  });
+  fuzz::require(blocks_ok == stream_ok && block_error == stream_error,
+                "CsvChunkReader and CsvBlockReader accept the same files, with the same errors");
+  if (blocks_ok && stream_ok) {
+    fuzz::require(blocked.rows() == streamed.rows() && blocked.cols() == streamed.cols() &&
+                      (blocked.array() == streamed.array()).all(),
+                  "CsvChunkReader and CsvBlockReader return the same numbers");
   }
 
   static const Model planar2 = load_robot("planar2");
