@@ -138,11 +138,12 @@ void process_block(const StreamSetup& s, const CsvBlockReader& reader, Worker& w
 // progress line needs no lock. The first error in file order is rethrown after every thread has
 // stopped, so no thread outlives the call.
 StreamingLeastSquares accumulate(const StreamSetup& s, const StreamingOptions& lsq_options,
-                                 int threads, Eigen::Index& samples,
+                                 int& threads, Eigen::Index& samples,
                                  const ProgressCallback& progress, const std::string& what) {
   const CsvBlockReader reader(s.path, {s.block_bytes});
   const std::int64_t blocks = reader.blocks();
   const int workers_used = static_cast<int>(std::min<std::int64_t>(threads, blocks));
+  threads = workers_used;  // told back: a small file has fewer blocks than workers
   std::vector<std::unique_ptr<Worker>> workers;
   for (int t = 0; t < workers_used; ++t) {
     workers.push_back(std::make_unique<Worker>(*s.model, *s.layout, s.base->rank, lsq_options));
@@ -303,7 +304,7 @@ IdentificationResult identify_stream(const Model& model, const std::string& path
       a += active;
     }
   }
-  const int threads =
+  int threads =
       stream.threads > 0
           ? std::min(stream.threads, kMaxThreads)
           : std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, kMaxThreads);
