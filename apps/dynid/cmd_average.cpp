@@ -3,6 +3,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -88,16 +89,9 @@ void run(const AverageCliOptions& o) {
   Eigen::MatrixXd kept = a.mean;
   Eigen::VectorXd phase = a.phase;
   if (filtered) {
-    Eigen::MatrixXd m(a.mean.rows(), static_cast<Eigen::Index>(measured.size()));
-    for (Eigen::Index c = 0; c < m.cols(); ++c) m.col(c) = a.mean.col(measured[c]);
-    const Eigen::MatrixXd f = lowpass_periodic(lowpass, m);
-    kept.resize(f.rows(), a.mean.cols());
-    phase.resize(f.rows());
-    for (Eigen::Index k = 0; k < f.rows(); ++k) {
-      kept.row(k) = a.mean.row(k * o.decimate);
-      phase[k] = a.phase[k * o.decimate];
-    }
-    for (Eigen::Index c = 0; c < f.cols(); ++c) kept.col(measured[c]) = f.col(c);
+    LowpassedPeriod f = lowpass_period_columns(lowpass, a.phase, a.mean, measured);
+    kept = std::move(f.x);
+    phase = std::move(f.phase);
   }
 
   std::vector<std::string> header = {"t"};
