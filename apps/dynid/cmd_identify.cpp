@@ -646,7 +646,8 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
                          "give a result of this robot");
       add_known_friction(options.known_friction, model, known.names, known.values, f);
     }
-    if (!o.noise.empty()) options.noise = read_sensor_noise(o.noise, model);
+    std::string noise_file;
+    if (!o.noise.empty()) options.noise = read_sensor_noise(o.noise, model, o.runs[0], &noise_file);
     if (!o.noise_std.empty()) options.noise = parse_noise_std(o.noise_std, model.dof());
     std::vector<ReferenceRecord> references;
     if (closed || o.repeat == "periods") {
@@ -662,6 +663,7 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     progress.finish();
     options.progress = nullptr;  // it refers to this scope's line
     for (size_t i = 0; i < result.runs.size(); ++i) result.runs[i].file = o.runs[i];
+    if (!noise_file.empty()) result.choices.emplace_back("noise_file", noise_file);
   }
   echo_choices("identify", read, result.choices);
   std::cout << identification_table(model, result);
@@ -1020,8 +1022,10 @@ void add_identify_command(CLI::App& app) {
                   "from qr, which must then repeat exactly)");
   cmd->add_option("--f0", o->f0,
                   "With --closed-loop spectral: the fundamental [Hz] instead of --period");
-  cmd->add_option("--noise", o->noise,
-                  "With --estimator ml: noise JSON of dynid average --json (std of q<j>, tau<j>)");
+  cmd->add_option(
+      "--noise", o->noise,
+      "With --estimator ml: noise JSON of dynid average --json (q<j>, tau<j>: std_averaged "
+      "when --data is its mean period, else the raw std)");
   cmd->add_option("--noise-std", o->noise_std,
                   "With --estimator ml: raw sensor noise q=S,tau=S [rad, N m] for every joint; "
                   "default: estimated from the data (white floor of each spectrum)");
