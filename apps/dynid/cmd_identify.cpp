@@ -709,29 +709,14 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     if (o.model == "integral") out["plot"]["energy"] = energy_plot_json(model, result, options);
   }
   if (o.physical) {
-    if (!result.not_excited.empty()) {
-      throw Error(
-          "--physical needs every base parameter determined by the data; these are not "
-          "excited: " +
-          result.not_excited.front() + (result.not_excited.size() > 1 ? " and others" : "") +
-          " (record a run that moves every joint)");
-    }
-    const PhysicalFit fit = physical_parameters(model, result.base, options.layout,
-                                                result.estimate.x, result.estimate.covariance);
-    // The torque error of the consistent set beside the unconstrained one, on the first run
-    // (read here only in the streaming mode, which keeps no run in memory).
+    // The torque errors on the first run (read here only in the streaming mode, which keeps no
+    // run in memory).
     if (records.empty()) records.push_back(read_joint_record(o.runs.front(), model, file));
-    const JointRecord& first = records.front();
-    IdentifyOptions same = options;
-    same.signal.cutoff_hz = result.processed.cutoff_hz;
-    const double physical_error =
-        validate_torques(model, first, result.names, fit.theta_b, same).relative_error_all;
-    const double free_error =
-        first_run_fit ? first_run_fit->relative_error_all
-                      : validate_torques(model, first, result.names, result.estimate.x, same)
-                            .relative_error_all;
-    physical_parameters_to_json(fit, physical_error, free_error, out);
-    std::cout << physical_parameters_text(fit, physical_error, free_error);
+    const PhysicalCheck c = physical_parameters_of_result(
+        model, result, options, records.front(), "--physical",
+        first_run_fit ? std::optional<double>(first_run_fit->relative_error_all) : std::nullopt);
+    physical_parameters_to_json(c.fit, c.physical_error, c.free_error, out);
+    std::cout << physical_parameters_text(c.fit, c.physical_error, c.free_error);
   }
   write_json(o.out, out);
   std::cout << "wrote " << o.out << '\n';

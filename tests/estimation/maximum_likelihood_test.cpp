@@ -14,6 +14,7 @@
 #include "dynid/dynamics/workspace.hpp"
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/maximum_likelihood.hpp"
+#include "dynid/estimation/processed_slice.hpp"
 #include "dynid/excitation/fourier_trajectory.hpp"
 #include "dynid/excitation/trajectory_samples.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
@@ -89,6 +90,30 @@ TEST(MaximumLikelihood, SensitivityMatchesMassMatrixAndRneaDifferences) {
       }
     }
   }
+}
+
+// A slice of a processed record regresses as the same rows of the whole record (row k of W
+// depends on sample k only), Coulomb indicator columns included; a range outside is an error.
+TEST(ProcessedSlice, RegressesAsTheSameRowsOfTheWholeRecord) {
+  const Model m = plant_model();
+  ParameterLayout layout = viscous_layout();
+  layout.coulomb = true;
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const int samples = 20, n = m.dof();
+  ProcessedRecord p;
+  p.record.t = Eigen::VectorXd::LinSpaced(samples, 0.0, 1.0);
+  p.record.q = p.record.dq = p.record.ddq = p.record.tau = p.moving_positive = p.moving_negative =
+      Eigen::MatrixXd(samples, n);
+  for (Eigen::MatrixXd* x : {&p.record.q, &p.record.dq, &p.record.ddq, &p.record.tau,
+                             &p.moving_positive, &p.moving_negative})
+    for (int k = 0; k < samples; ++k)
+      for (int j = 0; j < n; ++j) (*x)(k, j) = u(rng);
+  const Eigen::MatrixXd whole = processed_regressor(m, layout, false, p);
+  const ProcessedRecord s = processed_slice(p, 7, 9);
+  EXPECT_EQ(s.record.tau, p.record.tau.middleRows(7, 9));
+  EXPECT_EQ(processed_regressor(m, layout, false, s), whole.middleRows(7 * n, 9 * n));
+  EXPECT_THROW(processed_slice(p, 15, 6), Error);
 }
 
 struct MeasuredRun {
