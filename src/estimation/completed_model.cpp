@@ -23,10 +23,15 @@ std::string join(const std::vector<std::string>& names) {
 
 // The kind of a (base) parameter, which fixes its unit and order of magnitude: second moments
 // (XX … ZZ, Ia: kg·m²), first moments (MX, MY, MZ: kg·m), mass, viscous, Coulomb, offset
-// friction; anything else by its name without the joint index and the R of a regrouping.
-std::string parameter_kind(std::string name) {
+// friction; anything else by its name without the joint index and the R of a regrouping. `link`
+// receives the joint index (the digits of the name; empty when none).
+std::string parameter_kind(std::string name, std::string& link) {
   if (!name.empty() && name.back() == 'R') name.pop_back();
-  while (!name.empty() && std::isdigit(static_cast<unsigned char>(name.back()))) name.pop_back();
+  link.clear();
+  while (!name.empty() && std::isdigit(static_cast<unsigned char>(name.back()))) {
+    link.insert(link.begin(), name.back());
+    name.pop_back();
+  }
   for (const char* k : {"XX", "XY", "XZ", "YY", "YZ", "ZZ", "Ia"})
     if (name == k) return "second moment";
   for (const char* k : {"MX", "MY", "MZ"})
@@ -36,14 +41,20 @@ std::string parameter_kind(std::string name) {
   return name;
 }
 
-// Per estimated parameter, the scale m_k of its kind: the median of max(|estimate|, |nominal|)
-// over the parameters of the kind whose nominal value is not 0 (those with a scale of their own),
-// or of |estimate| over the whole kind when every nominal value of it is 0.
+// Per estimated parameter, the scale m_k of its kind (0: none): the median of |nominal| over the
+// parameters of the kind on the same link whose nominal value is not 0. Nominal values, not
+// estimates: the estimate of a badly determined parameter can be any size (XX4R = -250 on the
+// Comau example) and would pass its neighbours' σ as small. No nominal value of the kind on the
+// link: the link's parameter has no scale to borrow (the robot's other links are of other sizes:
+// a wrist's MX4 against the shoulder's MX2 = 35 kg·m passed σ = 0.07 and the computed-torque
+// wrist tracked 11x worse); a friction term borrows the median of max(|estimate|, |nominal|)
+// of its kind over the joints (a robot model often has no nominal friction at all).
 Eigen::VectorXd kind_scale(const std::vector<std::string>& names, const Eigen::VectorXd& estimate,
                            const Eigen::VectorXd& nominal) {
   const Eigen::Index e = estimate.size();
-  std::vector<std::string> kind(static_cast<size_t>(e));
-  for (Eigen::Index i = 0; i < e; ++i) kind[static_cast<size_t>(i)] = parameter_kind(names[i]);
+  std::vector<std::string> kind(static_cast<size_t>(e)), link(static_cast<size_t>(e));
+  for (Eigen::Index i = 0; i < e; ++i)
+    kind[static_cast<size_t>(i)] = parameter_kind(names[i], link[static_cast<size_t>(i)]);
   auto median = [](std::vector<double> v) {
     std::sort(v.begin(), v.end());
     const size_t h = v.size() / 2;
@@ -51,13 +62,16 @@ Eigen::VectorXd kind_scale(const std::vector<std::string>& names, const Eigen::V
   };
   Eigen::VectorXd out(e);
   for (Eigen::Index i = 0; i < e; ++i) {
-    std::vector<double> own, all;
+    const auto a = static_cast<size_t>(i);
+    const bool friction = kind[a] == "Fv" || kind[a] == "Fc" || kind[a] == "Fo";
+    std::vector<double> same_link, joints;
     for (Eigen::Index j = 0; j < e; ++j) {
-      if (kind[static_cast<size_t>(j)] != kind[static_cast<size_t>(i)]) continue;
-      all.push_back(std::abs(estimate[j]));
-      if (nominal[j] != 0.0) own.push_back(std::max(std::abs(estimate[j]), std::abs(nominal[j])));
+      const auto b = static_cast<size_t>(j);
+      if (kind[b] != kind[a]) continue;
+      joints.push_back(std::max(std::abs(estimate[j]), std::abs(nominal[j])));
+      if (nominal[j] != 0.0 && link[b] == link[a]) same_link.push_back(std::abs(nominal[j]));
     }
-    out[i] = own.empty() ? median(all) : median(own);
+    out[i] = !same_link.empty() ? median(same_link) : friction ? median(joints) : 0.0;
   }
   return out;
 }
@@ -125,8 +139,9 @@ CompletedModel complete_identified_model(
   // estimates; those whose σ exceeds max_relative_std (the data do not fix even the order of
   // magnitude along them) take the nominal model's component, the others keep the estimate's.
   // m_k: a parameter whose nominal value is 0 and whose estimate is within σ of 0 has no scale
-  // of its own, yet a σ far below its kind's values (MY2 beside MX2) determines it: it is 0 to
-  // within that σ. A nominal value that is not 0 is the parameter's own scale and stays it.
+  // of its own, yet a σ far below its link's nominal values of its kind (MY2 beside MX2)
+  // determines it: it is 0 to within that σ. A nominal value that is not 0 is the parameter's
+  // own scale and stays it.
   std::vector<Eigen::Index> bad, good;
   Eigen::VectorXd nominal_share = Eigen::VectorXd::Zero(m);  // diag of the projector
   if (e > 0 && completion.max_relative_std > 0.0) {

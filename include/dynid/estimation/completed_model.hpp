@@ -44,9 +44,9 @@ struct CompletedModel {
 ///   parameter plus data_regrouping·θ_u (IdentificationResult::data_regrouping), so the
 ///   estimates become θ̂ − D·θ_u⁰, which predicts the identification data exactly as before;
 /// - badly determined combinations: with z_i = θ_i/s_i, s_i = max(|θ̂_i|, |θ_i⁰|) (for θ_i⁰ = 0
-///   also m_k, the median of max(|θ̂_j|, |θ_j⁰|) over the parameters of its kind with θ_j⁰ ≠ 0:
-///   second moments, first moments, mass, Fv, Fc, Fo; a nominal 0 estimated within σ of 0 is
-///   judged against its kind's magnitude), and the scaled
+///   also m_k, the median of |θ_j⁰| ≠ 0 over its kind on its link: second moments, first
+///   moments, mass; friction: of max(|θ̂_j|, |θ_j⁰|) over the joints; a nominal 0 estimated
+///   within σ of 0 is judged against its kind's magnitude), and the scaled
 ///   covariance C̃ = S⁻¹CS⁻¹ = VΛVᵀ, the eigen-directions V_U with √λ above
 ///   options.max_relative_std take the nominal model's component, z = ẑ + V_U·V_Uᵀ·(z⁰ − ẑ);
 ///   the others keep the estimate's. The eigen-directions are independent estimates (exactly so
