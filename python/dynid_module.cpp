@@ -654,21 +654,10 @@ PYBIND11_MODULE(dynid, m) {
         }
         if (result.history_x.rows() > 0) out["plot"]["history"] = rls_history_plot_json(result);
         if (physical) {
-          if (!result.not_excited.empty()) {
-            throw Error("physical=True needs every base parameter determined by the data; " +
-                        result.not_excited.front() +
-                        " is not excited (record a run that moves "
-                        "every joint)");
-          }
-          const PhysicalFit fit = physical_parameters(
-              model, result.base, options.layout, result.estimate.x, result.estimate.covariance);
-          const double physical_error =
-              validate_torques(model, record, result.names, fit.theta_b, same).relative_error_all;
-          const double free_error =
-              replay ? replay->relative_error_all
-                     : validate_torques(model, record, result.names, result.estimate.x, same)
-                           .relative_error_all;
-          physical_parameters_to_json(fit, physical_error, free_error, out);
+          const PhysicalCheck c = physical_parameters_of_result(
+              model, result, options, record, "physical=True",
+              replay ? std::optional<double>(replay->relative_error_all) : std::nullopt);
+          physical_parameters_to_json(c.fit, c.physical_error, c.free_error, out);
         }
         py::gil_scoped_acquire acquire;
         return to_python(out);

@@ -3,6 +3,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -74,7 +75,8 @@ void run(const AverageCliOptions& o) {
   // Seed 2 section 3.4: averaged, then low-passed (8th-order Chebyshev at 80 Hz) and resampled
   // (200 Hz). The mean is one period of a periodic signal, so the zero-phase filter is circular:
   // no edge transient, nothing trimmed. Averaging and filtering are both linear, so their order
-  // does not matter; the noise statistics stay those of the raw samples.
+  // does not matter. The noise statistics are those of the raw samples (std) and of the mean
+  // period written (std_averaged, what identify --estimator ml needs when it fits the mean).
   PeriodicLowpassOptions lowpass;
   lowpass.design.family = filter.family;
   lowpass.design.order = filter.order;
@@ -88,16 +90,9 @@ void run(const AverageCliOptions& o) {
   Eigen::MatrixXd kept = a.mean;
   Eigen::VectorXd phase = a.phase;
   if (filtered) {
-    Eigen::MatrixXd m(a.mean.rows(), static_cast<Eigen::Index>(measured.size()));
-    for (Eigen::Index c = 0; c < m.cols(); ++c) m.col(c) = a.mean.col(measured[c]);
-    const Eigen::MatrixXd f = lowpass_periodic(lowpass, m);
-    kept.resize(f.rows(), a.mean.cols());
-    phase.resize(f.rows());
-    for (Eigen::Index k = 0; k < f.rows(); ++k) {
-      kept.row(k) = a.mean.row(k * o.decimate);
-      phase[k] = a.phase[k * o.decimate];
-    }
-    for (Eigen::Index c = 0; c < f.cols(); ++c) kept.col(measured[c]) = f.col(c);
+    LowpassedPeriod f = lowpass_period_columns(lowpass, a.phase, a.mean, measured);
+    kept = std::move(f.x);
+    phase = std::move(f.phase);
   }
 
   std::vector<std::string> header = {"t"};
@@ -107,6 +102,7 @@ void run(const AverageCliOptions& o) {
   nlohmann::json j;
   if (!o.json.empty()) {
     j["data"] = o.data;
+    j["out"] = o.out;
     j["period"] = period;
     j["sample_time"] = a.sample_time;
     j["samples_per_period"] = a.samples_per_period;
@@ -137,11 +133,13 @@ void run(const AverageCliOptions& o) {
     j["channels"] = nlohmann::json::array();
     for (std::size_t c = 0; c < names.size(); ++c) {
       const ChannelNoise& ch = a.channels[c];
-      j["channels"].push_back({{"name", names[c]},
-                               {"std", ch.std},
-                               {"skewness", json_number(ch.skewness)},
-                               {"kurtosis", json_number(ch.kurtosis)},
-                               {"normality_p", json_number(ch.normality_p)}});
+      j["channels"].push_back(
+          {{"name", names[c]},
+           {"std", ch.std},
+           {"std_averaged", averaged_noise_std(ch.std, a.periods, filtered ? &lowpass : nullptr)},
+           {"skewness", json_number(ch.skewness)},
+           {"kurtosis", json_number(ch.kurtosis)},
+           {"normality_p", json_number(ch.normality_p)}});
     }
   }
   for (const std::string& w : warnings) std::cerr << "warning: " << w << '\n';
@@ -187,8 +185,9 @@ void add_average_command(CLI::App& app) {
                   "same columns")
       ->required();
   cmd->add_option("--json", o->json,
-                  "Noise JSON: periods, samples_per_period, partial_period, channels (name, std, "
-                  "skewness, kurtosis, normality_p)");
+                  "Noise JSON: periods, samples_per_period, partial_period, channels (name, std of "
+                  "the raw samples, std_averaged of the --out mean period, skewness, kurtosis, "
+                  "normality_p)");
   cmd->add_option("--start", o->start,
                   "Time of the first period's start [s]; default the first sample");
   cmd->add_option("--skip-periods", o->skip_periods,

@@ -646,7 +646,8 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
                          "give a result of this robot");
       add_known_friction(options.known_friction, model, known.names, known.values, f);
     }
-    if (!o.noise.empty()) options.noise = read_sensor_noise(o.noise, model);
+    std::string noise_file;
+    if (!o.noise.empty()) options.noise = read_sensor_noise(o.noise, model, o.runs[0], &noise_file);
     if (!o.noise_std.empty()) options.noise = parse_noise_std(o.noise_std, model.dof());
     std::vector<ReferenceRecord> references;
     if (closed || o.repeat == "periods") {
@@ -662,6 +663,7 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     progress.finish();
     options.progress = nullptr;  // it refers to this scope's line
     for (size_t i = 0; i < result.runs.size(); ++i) result.runs[i].file = o.runs[i];
+    if (!noise_file.empty()) result.choices.emplace_back("noise_file", noise_file);
   }
   echo_choices("identify", read, result.choices);
   std::cout << identification_table(model, result);
@@ -707,29 +709,14 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     if (o.model == "integral") out["plot"]["energy"] = energy_plot_json(model, result, options);
   }
   if (o.physical) {
-    if (!result.not_excited.empty()) {
-      throw Error(
-          "--physical needs every base parameter determined by the data; these are not "
-          "excited: " +
-          result.not_excited.front() + (result.not_excited.size() > 1 ? " and others" : "") +
-          " (record a run that moves every joint)");
-    }
-    const PhysicalFit fit = physical_parameters(model, result.base, options.layout,
-                                                result.estimate.x, result.estimate.covariance);
-    // The torque error of the consistent set beside the unconstrained one, on the first run
-    // (read here only in the streaming mode, which keeps no run in memory).
+    // The torque errors on the first run (read here only in the streaming mode, which keeps no
+    // run in memory).
     if (records.empty()) records.push_back(read_joint_record(o.runs.front(), model, file));
-    const JointRecord& first = records.front();
-    IdentifyOptions same = options;
-    same.signal.cutoff_hz = result.processed.cutoff_hz;
-    const double physical_error =
-        validate_torques(model, first, result.names, fit.theta_b, same).relative_error_all;
-    const double free_error =
-        first_run_fit ? first_run_fit->relative_error_all
-                      : validate_torques(model, first, result.names, result.estimate.x, same)
-                            .relative_error_all;
-    physical_parameters_to_json(fit, physical_error, free_error, out);
-    std::cout << physical_parameters_text(fit, physical_error, free_error);
+    const PhysicalCheck c = physical_parameters_of_result(
+        model, result, options, records.front(), "--physical",
+        first_run_fit ? std::optional<double>(first_run_fit->relative_error_all) : std::nullopt);
+    physical_parameters_to_json(c.fit, c.physical_error, c.free_error, out);
+    std::cout << physical_parameters_text(c.fit, c.physical_error, c.free_error);
   }
   write_json(o.out, out);
   std::cout << "wrote " << o.out << '\n';
@@ -1020,8 +1007,10 @@ void add_identify_command(CLI::App& app) {
                   "from qr, which must then repeat exactly)");
   cmd->add_option("--f0", o->f0,
                   "With --closed-loop spectral: the fundamental [Hz] instead of --period");
-  cmd->add_option("--noise", o->noise,
-                  "With --estimator ml: noise JSON of dynid average --json (std of q<j>, tau<j>)");
+  cmd->add_option(
+      "--noise", o->noise,
+      "With --estimator ml: noise JSON of dynid average --json (q<j>, tau<j>: std_averaged "
+      "when --data is its mean period, else the raw std)");
   cmd->add_option("--noise-std", o->noise_std,
                   "With --estimator ml: raw sensor noise q=S,tau=S [rad, N m] for every joint; "
                   "default: estimated from the data (white floor of each spectrum)");

@@ -1,6 +1,7 @@
 #include "dynid/estimation/completed_model.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <sstream>
 
@@ -18,6 +19,61 @@ std::string join(const std::vector<std::string>& names) {
   std::string list;
   for (const std::string& name : names) list += (list.empty() ? "" : ", ") + name;
   return list;
+}
+
+// The kind of a (base) parameter, which fixes its unit and order of magnitude: second moments
+// (XX … ZZ, Ia: kg·m²), first moments (MX, MY, MZ: kg·m), mass, viscous, Coulomb, offset
+// friction; anything else by its name without the joint index and the R of a regrouping. `link`
+// receives the joint index (the digits of the name; empty when none).
+std::string parameter_kind(std::string name, std::string& link) {
+  if (!name.empty() && name.back() == 'R') name.pop_back();
+  link.clear();
+  while (!name.empty() && std::isdigit(static_cast<unsigned char>(name.back()))) {
+    link.insert(link.begin(), name.back());
+    name.pop_back();
+  }
+  for (const char* k : {"XX", "XY", "XZ", "YY", "YZ", "ZZ", "Ia"})
+    if (name == k) return "second moment";
+  for (const char* k : {"MX", "MY", "MZ"})
+    if (name == k) return "first moment";
+  if (name == "Fvp" || name == "Fvn") return "Fv";
+  if (name == "Fcp" || name == "Fcn") return "Fc";
+  return name;
+}
+
+// Per estimated parameter, the scale m_k of its kind (0: none): the median of |nominal| over the
+// parameters of the kind on the same link whose nominal value is not 0. Nominal values, not
+// estimates: the estimate of a badly determined parameter can be any size (XX4R = -250 on the
+// Comau example) and would pass its neighbours' σ as small. No nominal value of the kind on the
+// link: the link's parameter has no scale to borrow (the robot's other links are of other sizes:
+// a wrist's MX4 against the shoulder's MX2 = 35 kg·m passed σ = 0.07 and the computed-torque
+// wrist tracked 11x worse); a friction term borrows the median of max(|estimate|, |nominal|)
+// of its kind over the joints (a robot model often has no nominal friction at all).
+Eigen::VectorXd kind_scale(const std::vector<std::string>& names, const Eigen::VectorXd& estimate,
+                           const Eigen::VectorXd& nominal) {
+  const Eigen::Index e = estimate.size();
+  std::vector<std::string> kind(static_cast<size_t>(e)), link(static_cast<size_t>(e));
+  for (Eigen::Index i = 0; i < e; ++i)
+    kind[static_cast<size_t>(i)] = parameter_kind(names[i], link[static_cast<size_t>(i)]);
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const size_t h = v.size() / 2;
+    return v.empty() ? 0.0 : v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
+  };
+  Eigen::VectorXd out(e);
+  for (Eigen::Index i = 0; i < e; ++i) {
+    const auto a = static_cast<size_t>(i);
+    const bool friction = kind[a] == "Fv" || kind[a] == "Fc" || kind[a] == "Fo";
+    std::vector<double> same_link, joints;
+    for (Eigen::Index j = 0; j < e; ++j) {
+      const auto b = static_cast<size_t>(j);
+      if (kind[b] != kind[a]) continue;
+      joints.push_back(std::max(std::abs(estimate[j]), std::abs(nominal[j])));
+      if (nominal[j] != 0.0 && link[b] == link[a]) same_link.push_back(std::abs(nominal[j]));
+    }
+    out[i] = !same_link.empty() ? median(same_link) : friction ? median(joints) : 0.0;
+  }
+  return out;
 }
 
 }  // namespace
@@ -78,18 +134,25 @@ CompletedModel complete_identified_model(
         "the result stores no data regroupings (written by an older dynid): the estimates still "
         "contain the not excited parameters' share on the identification data");
   }
-  // Badly determined directions: in the coordinates z_i = θ_i/s_i, s_i = max(|θ̂_i|, |θ_i⁰|), the
-  // eigenvectors of the covariance are independent estimates; those whose σ exceeds
-  // max_relative_std (the data do not fix even the order of magnitude along them) take the
-  // nominal model's component, the others keep the estimate's.
+  // Badly determined directions: in the coordinates z_i = θ_i/s_i, s_i = max(|θ̂_i|, |θ_i⁰|) (and
+  // the kind's scale m_k when θ_i⁰ = 0), the eigenvectors of the covariance are independent
+  // estimates; those whose σ exceeds max_relative_std (the data do not fix even the order of
+  // magnitude along them) take the nominal model's component, the others keep the estimate's.
+  // m_k: a parameter whose nominal value is 0 and whose estimate is within σ of 0 has no scale
+  // of its own, yet a σ far below its link's nominal values of its kind (MY2 beside MX2)
+  // determines it: it is 0 to within that σ. A nominal value that is not 0 is the parameter's
+  // own scale and stays it.
   std::vector<Eigen::Index> bad, good;
   Eigen::VectorXd nominal_share = Eigen::VectorXd::Zero(m);  // diag of the projector
   if (e > 0 && completion.max_relative_std > 0.0) {
     if (covariance.size() != 0 && covariance.allFinite()) {
       Eigen::VectorXd scale(e);
-      for (Eigen::Index i = 0; i < e; ++i) {
+      for (Eigen::Index i = 0; i < e; ++i)
         scale[i] = std::max(std::abs(x[i]), std::abs(nominal_at[i]));
-        if (!(scale[i] > 0.0)) scale[i] = 1.0;  // both zero: any scale, nothing to move
+      const Eigen::VectorXd kind = kind_scale(names, x.head(e), nominal_at.head(e));
+      for (Eigen::Index i = 0; i < e; ++i) {
+        if (nominal_at[i] == 0.0) scale[i] = std::max(scale[i], kind[i]);
+        if (!(scale[i] > 0.0)) scale[i] = 1.0;  // all zero: any scale, nothing to move
       }
       const Eigen::MatrixXd scaled =
           scale.cwiseInverse().asDiagonal() * covariance * scale.cwiseInverse().asDiagonal();
@@ -141,7 +204,8 @@ CompletedModel complete_identified_model(
     s << out.undetermined_directions
       << " combination(s) of the parameters are badly determined (std above "
       << completion.max_relative_std
-      << " x max(|estimate|, |nominal|)) and take the nominal model's values; mostly nominal now: "
+      << " x max(|estimate|, |nominal|), or its kind's scale where the nominal is 0) and take the "
+         "nominal model's values; mostly nominal now: "
       << (out.nominal_badly_determined.empty() ? std::string("none")
                                                : join(out.nominal_badly_determined));
     out.warnings.push_back(s.str());

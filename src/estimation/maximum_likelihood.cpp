@@ -15,6 +15,7 @@
 #include "dynid/common/message.hpp"
 #include "dynid/estimation/closed_loop.hpp"
 #include "dynid/estimation/least_squares.hpp"
+#include "dynid/estimation/processed_slice.hpp"
 #include "dynid/estimation/statistics.hpp"
 #include "dynid/signal/lowpass_design.hpp"
 #include "dynid/signal/noise_floor.hpp"
@@ -51,20 +52,12 @@ Eigen::MatrixXd differential_sensitivity(const Model& model, const ParameterLayo
   std::stable_sort(order.begin(), order.end(),
                    [&](Eigen::Index a, Eigen::Index b) { return sample[a] < sample[b]; });
   constexpr Eigen::Index kChunk = 32;
-  const bool coulomb = processed.moving_positive.size() > 0;
   ProcessedRecord work;
   std::size_t next = 0;  // first entry of `order` not yet written
   for (Eigen::Index k0 = 0; k0 < m && next < order.size(); k0 += kChunk) {
     const Eigen::Index len = std::min(kChunk, m - k0);
     if (sample[order[next]] >= k0 + len) continue;  // no rows in this chunk
-    work.record.t = processed.record.t.segment(k0, len);
-    work.record.q = processed.record.q.middleRows(k0, len);
-    work.record.dq = processed.record.dq.middleRows(k0, len);
-    work.record.ddq = processed.record.ddq.middleRows(k0, len);
-    if (coulomb) {
-      work.moving_positive = processed.moving_positive.middleRows(k0, len);
-      work.moving_negative = processed.moving_negative.middleRows(k0, len);
-    }
+    work = processed_slice(processed, k0, len);
     std::size_t end = next;
     while (end < order.size() && sample[order[end]] < k0 + len) ++end;
     Eigen::MatrixXd* channel[3] = {&work.record.q, &work.record.dq, &work.record.ddq};

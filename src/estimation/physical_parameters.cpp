@@ -10,6 +10,7 @@
 #include <boost/math/distributions/chi_squared.hpp>
 
 #include "dynid/common/error.hpp"
+#include "dynid/estimation/identification.hpp"
 
 namespace dynid {
 
@@ -334,6 +335,31 @@ PhysicalFit physical_parameters(const Model& nominal, const BaseParameters& base
          "intervals are too narrow";
     throw Error(m.str());
   }
+  return out;
+}
+
+PhysicalCheck physical_parameters_of_result(const Model& model, const IdentificationResult& result,
+                                            const IdentifyOptions& options, const JointRecord& run,
+                                            const std::string& option,
+                                            std::optional<double> free_error) {
+  // A parameter the data did not determine has no meaningful σ: the χ² test against the
+  // estimate would accept any value for it.
+  if (!result.not_excited.empty())
+    throw Error(option +
+                " needs every base parameter determined by the data; these are not excited: " +
+                result.not_excited.front() + (result.not_excited.size() > 1 ? " and others" : "") +
+                " (record a run that moves every joint)");
+  PhysicalCheck out;
+  out.fit = physical_parameters(model, result.base, options.layout, result.estimate.x,
+                                result.estimate.covariance);
+  IdentifyOptions same = options;
+  same.signal.cutoff_hz = result.processed.cutoff_hz;
+  out.physical_error =
+      validate_torques(model, run, result.names, out.fit.theta_b, same).relative_error_all;
+  out.free_error =
+      free_error
+          ? *free_error
+          : validate_torques(model, run, result.names, result.estimate.x, same).relative_error_all;
   return out;
 }
 

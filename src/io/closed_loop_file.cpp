@@ -1,6 +1,7 @@
 #include "dynid/io/closed_loop_file.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -41,7 +42,8 @@ ReferenceRecord read_reference_columns(const std::string& path, const Model& mod
   return out;
 }
 
-SensorNoise read_sensor_noise(const std::string& path, const Model& model) {
+SensorNoise read_sensor_noise(const std::string& path, const Model& model, const std::string& data,
+                              std::string* which) {
   std::ifstream in(path);
   if (!in) throw Error("--noise '" + path + "' cannot be opened; check the path");
   nlohmann::json j;
@@ -54,6 +56,26 @@ SensorNoise read_sensor_noise(const std::string& path, const Model& model) {
     throw Error("--noise '" + path +
                 "' has no channels list; give the file of dynid average "
                 "--json");
+  // The mean period's noise is the raw one over √(periods·decimate): fitting the mean with the
+  // raw std misstates the variance factor by that ratio (docs/methods/maximum_likelihood.md).
+  auto same_file = [](const nlohmann::json& name, const std::string& other) {
+    std::error_code ec;
+    return !other.empty() && name.is_string() &&
+           std::filesystem::equivalent(name.get<std::string>(), other, ec) && !ec;
+  };
+  const bool averaged = same_file(j.value("out", nlohmann::json()), data);
+  const std::string field = averaged ? "std_averaged" : "std";
+  if (which) {
+    if (averaged)
+      *which = path + ": std_averaged, the noise of the mean period " + data + " (" +
+               j.value("periods", nlohmann::json()).dump() + " periods averaged)";
+    else if (!data.empty() && !same_file(j.value("data", nlohmann::json()), data))
+      *which = path + ": std, the raw per-sample noise of " +
+               j.value("data", nlohmann::json("?")).dump() + "; " + data +
+               " is neither that run nor its mean period (out), so it is taken as raw";
+    else
+      *which = path + ": std, the raw per-sample noise of the run " + data;
+  }
   const int n = model.dof();
   SensorNoise out;
   out.q.resize(n);
@@ -65,11 +87,13 @@ SensorNoise read_sensor_noise(const std::string& path, const Model& model) {
       if (!c.is_object() || !c.contains("name") || !c["name"].is_string()) continue;
       const std::string name = c["name"].get<std::string>();
       if (name != a && name != b) continue;
-      if (!c.contains("std") || !c["std"].is_number() || !std::isfinite(c["std"].get<double>()) ||
-          c["std"].get<double>() < 0.0)
-        throw Error("--noise '" + path + "': channel " + name +
-                    " has no finite std >= 0; give the file of dynid average --json");
-      return c["std"].get<double>();
+      if (!c.contains(field) || !c[field].is_number() || !std::isfinite(c[field].get<double>()) ||
+          c[field].get<double>() < 0.0)
+        throw Error(
+            "--noise '" + path + "': channel " + name + " has no finite " + field +
+            " >= 0; give the file of dynid average --json" +
+            (averaged ? " (a file written before std_averaged existed: average again)" : ""));
+      return c[field].get<double>();
     }
     throw Error("--noise '" + path + "' has no channel " + a +
                 ": average the run with its q and tau columns (dynid average)");

@@ -297,6 +297,30 @@ constexpr double kPositionSpread = 0.1;
 
 }  // namespace
 
+double averaged_noise_std(double raw_std, int periods, const PeriodicLowpassOptions* lowpass) {
+  if (!std::isfinite(raw_std) || raw_std < 0.0 || periods < 1)
+    throw Error("averaged_noise_std: needs a finite std >= 0 and periods >= 1, got " +
+                short_number(raw_std) + " and " + std::to_string(periods));
+  double gamma = 1.0, decimate = 1.0;
+  if (lowpass) {
+    if (lowpass->decimate < 1)
+      throw Error("averaged_noise_std: decimation must be >= 1, got " +
+                  std::to_string(lowpass->decimate));
+    decimate = lowpass->decimate;
+    // Mean of |H|⁴ over the pass band by the midpoint rule: the ripple of an order-8 Chebyshev
+    // has 4 cycles there, 400 points resolve it far below the 1e-3 this is good for.
+    const SosFilter h = design_lowpass_unit_dc(lowpass->design);
+    constexpr int kPoints = 400;
+    gamma = 0.0;
+    for (int i = 0; i < kPoints; ++i) {
+      const double f = lowpass->design.cutoff_hz * (i + 0.5) / kPoints;
+      gamma += std::pow(std::norm(frequency_response(h, f, lowpass->design.sample_rate_hz)), 2) /
+               kPoints;
+    }
+  }
+  return raw_std * std::sqrt(gamma / (static_cast<double>(periods) * decimate));
+}
+
 bool is_reference_channel(const std::string& name) {
   for (const char* prefix : {"qr", "dqr", "ddqr"})
     if (has_index_suffix(name, prefix)) return true;

@@ -11,6 +11,16 @@
 #include "dynid/common/message.hpp"
 
 namespace dynid {
+namespace {
+
+// Rows 0, n, 2n, … of x (n divides x.rows(), checked by the caller).
+Eigen::MatrixXd every_nth_row(const Eigen::Ref<const Eigen::MatrixXd>& x, int n) {
+  Eigen::MatrixXd out(x.rows() / n, x.cols());
+  for (Eigen::Index k = 0; k < out.rows(); ++k) out.row(k) = x.row(k * n);
+  return out;
+}
+
+}  // namespace
 
 Eigen::MatrixXd filtfilt_periodic(const SosFilter& filter,
                                   const Eigen::Ref<const Eigen::MatrixXd>& x) {
@@ -64,9 +74,29 @@ Eigen::MatrixXd lowpass_periodic(const PeriodicLowpassOptions& options,
                 " Hz (rate " + short_number(options.design.sample_rate_hz) + " Hz / (2 x " +
                 std::to_string(n) +
                 ")): the decimation would alias; lower the cut-off or the decimation factor");
-  const Eigen::MatrixXd y = filtfilt_periodic(design_lowpass_unit_dc(options.design), x);
-  Eigen::MatrixXd out(p / n, x.cols());
-  for (Eigen::Index k = 0; k < out.rows(); ++k) out.row(k) = y.row(k * n);
+  return every_nth_row(filtfilt_periodic(design_lowpass_unit_dc(options.design), x), n);
+}
+
+LowpassedPeriod lowpass_period_columns(const PeriodicLowpassOptions& options,
+                                       const Eigen::Ref<const Eigen::VectorXd>& phase,
+                                       const Eigen::Ref<const Eigen::MatrixXd>& x,
+                                       const std::vector<Eigen::Index>& filtered) {
+  if (phase.size() != x.rows())
+    throw Error("periodic filter: " + std::to_string(phase.size()) + " phase times for " +
+                std::to_string(x.rows()) + " rows");
+  Eigen::MatrixXd selected(x.rows(), static_cast<Eigen::Index>(filtered.size()));
+  for (std::size_t c = 0; c < filtered.size(); ++c) {
+    if (filtered[c] < 0 || filtered[c] >= x.cols())
+      throw Error("periodic filter: column " + std::to_string(filtered[c]) + " outside the " +
+                  std::to_string(x.cols()) + " columns");
+    selected.col(static_cast<Eigen::Index>(c)) = x.col(filtered[c]);
+  }
+  const Eigen::MatrixXd low = lowpass_periodic(options, selected);  // checks N against P
+  LowpassedPeriod out;
+  out.phase = every_nth_row(phase, options.decimate);
+  out.x = every_nth_row(x, options.decimate);
+  for (std::size_t c = 0; c < filtered.size(); ++c)
+    out.x.col(filtered[c]) = low.col(static_cast<Eigen::Index>(c));
   return out;
 }
 

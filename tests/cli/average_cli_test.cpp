@@ -62,6 +62,11 @@ TEST_F(AverageCli, WritesTheMeanPeriodAndTheNoiseOfEveryChannel) {
   EXPECT_NEAR(j["channels"][1]["std"].get<double>(), 0.01, 4 * 0.01 / std::sqrt(2 * n));
   EXPECT_NEAR(j["channels"][2]["std"].get<double>(), 0.1, 4 * 0.1 / std::sqrt(2 * n));
   EXPECT_GT(j["channels"][2]["normality_p"].get<double>(), 1e-3);
+  // The mean period's noise, unfiltered: the raw std over √(periods) (averaged_noise_std()).
+  EXPECT_EQ(j["out"], work("avg.csv"));
+  for (int c = 1; c < 3; ++c)
+    EXPECT_NEAR(j["channels"][c]["std_averaged"].get<double>(),
+                j["channels"][c]["std"].get<double>() / std::sqrt(10.0), 1e-15);
   std::ifstream avg(work("avg.csv"));
   std::string header;
   std::getline(avg, header);

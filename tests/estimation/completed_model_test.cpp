@@ -113,6 +113,45 @@ TEST(CompletedModel, OneJointRunGivesAPositiveDefiniteModelThatPredictsAsWell) {
   RecordProperty("nominal_badly_determined", static_cast<int>(c.nominal_badly_determined.size()));
 }
 
+// planar2's nominal MY1 = MY2 = 0. An estimate of MY2 within its interval of 0 whose σ is small
+// against the other first moments (MX2 = 0.5) is determined (it is 0 to within that σ): no
+// warning, the estimate kept. The rule used to judge σ against max(|estimate|, |nominal|) alone,
+// 0.003 here, and called it badly determined. A parameter with a nominal value of its own keeps
+// it as its scale: ZZ2 with σ twice its value still is badly determined.
+TEST(CompletedModel, AZeroNominalEstimatedNearZeroWithASmallStdIsDetermined) {
+  const Model m = load_robot("planar2");
+  IdentifyOptions o;
+  BaseParameterOptions bo;
+  bo.layout = o.layout;
+  const BaseParameters base = compute_base_parameters(m, bo);
+  const Eigen::VectorXd nominal = base.reduce(o.layout.parameters(m));
+  Eigen::VectorXd x = nominal, sd = 0.01 * nominal.cwiseAbs();
+  auto at = [&](const std::string& name) {
+    const auto it = std::find(base.names.begin(), base.names.end(), name);
+    EXPECT_NE(it, base.names.end()) << name;
+    return static_cast<Eigen::Index>(it - base.names.begin());
+  };
+  ASSERT_EQ(nominal[at("MY2")], 0.0);
+  ASSERT_EQ(nominal[at("MY1")], 0.0);
+  ASSERT_GT(std::abs(nominal[at("MX2")]), 0.1);
+  x[at("MY2")] = 0.003;
+  sd[at("MY2")] = 0.01;
+  x[at("MY1")] = -0.002;
+  sd[at("MY1")] = 0.01;
+  const Eigen::MatrixXd c = sd.array().square().matrix().asDiagonal();
+  CompletedModel done = complete_identified_model(m, base.names, x, sd, {}, {}, c, o);
+  EXPECT_EQ(done.undetermined_directions, 0);
+  EXPECT_TRUE(done.nominal_badly_determined.empty());
+  EXPECT_TRUE(done.warnings.empty()) << done.warnings.front();
+  EXPECT_EQ(done.values[at("MY2")], 0.003);
+  Eigen::VectorXd sd2 = sd;
+  sd2[at("ZZ2")] = 2.0 * std::abs(x[at("ZZ2")]);
+  const Eigen::MatrixXd c2 = sd2.array().square().matrix().asDiagonal();
+  done = complete_identified_model(m, base.names, x, sd2, {}, {}, c2, o);
+  EXPECT_EQ(done.undetermined_directions, 1);
+  EXPECT_EQ(done.nominal_badly_determined, std::vector<std::string>{"ZZ2"});
+}
+
 TEST(CompletedModel, SizesThatDoNotMatchAreAnError) {
   const Model m = arm(1.0, 1.0, 1.0);
   IdentifyOptions o;

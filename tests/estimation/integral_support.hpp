@@ -15,6 +15,7 @@
 #include "dynid/estimation/equation_block.hpp"
 #include "dynid/estimation/identification.hpp"
 #include "dynid/estimation/least_squares.hpp"
+#include "dynid/estimation/processed_slice.hpp"
 #include "dynid/estimation/statistics.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
 #include "dynid/io/csv_reader.hpp"
@@ -121,20 +122,12 @@ inline ProcessedRecord with_model_torques(const Model& model, const ParameterLay
                                           const Eigen::VectorXd& x, ProcessedRecord processed) {
   const Eigen::Index m = processed.record.t.size();
   const int n = model.dof();
-  const bool coulomb = processed.moving_positive.rows() == m;
   for (Eigen::Index first = 0; first < m; first += 4096) {
     const Eigen::Index len = std::min<Eigen::Index>(4096, m - first);
-    ProcessedRecord chunk;
-    chunk.record.t = processed.record.t.segment(first, len);
-    chunk.record.q = processed.record.q.middleRows(first, len);
-    chunk.record.dq = processed.record.dq.middleRows(first, len);
-    chunk.record.ddq = processed.record.ddq.middleRows(first, len);
-    if (coulomb) {
-      chunk.moving_positive = processed.moving_positive.middleRows(first, len);
-      chunk.moving_negative = processed.moving_negative.middleRows(first, len);
-    }
     const Eigen::VectorXd tau =
-        base.select(processed_regressor(model, layout, coupling, chunk)) * x;
+        base.select(
+            processed_regressor(model, layout, coupling, processed_slice(processed, first, len))) *
+        x;
     for (Eigen::Index k = 0; k < len; ++k)
       processed.record.tau.row(first + k) = tau.segment(k * n, n).transpose();
   }

@@ -14,10 +14,10 @@ namespace dynid {
 struct ModelCompletionOptions {
   /// A combination of the estimated parameters is badly determined, and takes the nominal model's
   /// value, when its standard deviation exceeds this fraction of the parameters' scale (each
-  /// scaled by max(|estimate|, |nominal value|)): the data do not fix even its order of
-  /// magnitude (e.g. XX2R of a run in which joint 2's axis never changes orientation, or the two
-  /// of four gravity parameters a one-joint run cannot separate). 0 or less: only the not excited
-  /// ones are filled.
+  /// scaled by max(|estimate|, |nominal value|), or its kind's magnitude where the nominal value is
+  /// 0): the data do not fix even its order of magnitude (e.g. XX2R of a run in which joint 2's
+  /// axis never changes orientation, or the two of four gravity parameters a one-joint run cannot
+  /// separate). 0 or less: only the not excited ones are filled.
   double max_relative_std = 1.0;
 };
 
@@ -43,7 +43,10 @@ struct CompletedModel {
 /// - not_excited parameters θ_u take the nominal base values θ_u⁰; each estimate is its base
 ///   parameter plus data_regrouping·θ_u (IdentificationResult::data_regrouping), so the
 ///   estimates become θ̂ − D·θ_u⁰, which predicts the identification data exactly as before;
-/// - badly determined combinations: with z_i = θ_i/s_i, s_i = max(|θ̂_i|, |θ_i⁰|), and the scaled
+/// - badly determined combinations: with z_i = θ_i/s_i, s_i = max(|θ̂_i|, |θ_i⁰|) (for θ_i⁰ = 0
+///   also m_k, the median of |θ_j⁰| ≠ 0 over its kind on its link: second moments, first
+///   moments, mass; friction: of max(|θ̂_j|, |θ_j⁰|) over the joints; a nominal 0 estimated
+///   within σ of 0 is judged against its kind's magnitude), and the scaled
 ///   covariance C̃ = S⁻¹CS⁻¹ = VΛVᵀ, the eigen-directions V_U with √λ above
 ///   options.max_relative_std take the nominal model's component, z = ẑ + V_U·V_Uᵀ·(z⁰ − ẑ);
 ///   the others keep the estimate's. The eigen-directions are independent estimates (exactly so

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,10 @@
 #include "dynid/regressor/parameter_layout.hpp"
 
 namespace dynid {
+
+struct IdentificationResult;
+struct IdentifyOptions;
+struct JointRecord;
 
 /// Options of physical_parameters() (Ceres style).
 struct PhysicalFitOptions {
@@ -68,6 +73,26 @@ PhysicalFit physical_parameters(const Model& nominal, const BaseParameters& base
                                 const ParameterLayout& layout, const Eigen::VectorXd& theta_b,
                                 const Eigen::MatrixXd& covariance,
                                 const PhysicalFitOptions& options = {});
+
+/// physical_parameters() of an identification's estimate, with the relative torque error
+/// ‖τ − τ̂‖/‖τ‖ over every row of `run` of the consistent set and of the free estimate.
+struct PhysicalCheck {
+  PhysicalFit fit;              ///< the consistent set
+  double physical_error = 0.0;  ///< torque error of fit.theta_b on the run
+  double free_error = 0.0;      ///< torque error of the identified estimate on the run
+};
+
+/// The consistent set of `result` (identify() of `model` with `options`) and both torque errors
+/// on `run` (validate_torques() with identify's cut-off, result.processed.cutoff_hz), as
+/// `identify --physical` and the Python physical=True report them. `free_error`: the free
+/// estimate's error when the caller already validated it on `run` (else computed). `option`
+/// names the request in the error ("--physical", "physical=True"). Throws dynid::Error when some
+/// base parameter is not excited by the data (the message names the first, and the fix), and as
+/// physical_parameters() and validate_torques().
+PhysicalCheck physical_parameters_of_result(const Model& model, const IdentificationResult& result,
+                                            const IdentifyOptions& options, const JointRecord& run,
+                                            const std::string& option,
+                                            std::optional<double> free_error = std::nullopt);
 
 /// The 4×4 pseudo-inertia J = [[Σ, h], [hᵀ, m]] of standard link parameters (XX XY XZ YY YZ ZZ MX
 /// MY MZ M about the link origin): Σ = ½tr(I)·𝟙 − I, h = (MX, MY, MZ). J ≻ 0 exactly when the

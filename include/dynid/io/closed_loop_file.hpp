@@ -18,10 +18,14 @@ namespace dynid {
 ReferenceRecord read_reference_columns(const std::string& path, const Model& model,
                                        const RunFileOptions& options, const JointRecord& run);
 
-/// Raw sensor noise per joint from the JSON of `dynid average --json` (channels q<j>, tau<j> or
-/// q_<joint>, tau_<joint>, field std). Throws dynid::Error naming the file for a missing channel
-/// or a std that is not a finite number >= 0.
-SensorNoise read_sensor_noise(const std::string& path, const Model& model);
+/// Sensor noise per joint from the JSON of `dynid average --json` (channels q<j>, tau<j> or
+/// q_<joint>, tau_<joint>): the noise of the data identify fits. When `data` is the mean period
+/// the file names as its `out` (same file on disk), the field std_averaged (the mean's noise,
+/// averaged_noise_std()); otherwise std (the raw per-sample noise). `which`, if given, receives
+/// one line saying which and why. Throws dynid::Error naming the file for a missing channel or
+/// field, or a std that is not a finite number >= 0.
+SensorNoise read_sensor_noise(const std::string& path, const Model& model,
+                              const std::string& data = "", std::string* which = nullptr);
 
 /// `--noise-std q=S,tau=S` (one value for every joint each; either may be omitted). Throws
 /// dynid::UsageError for anything else or a value that is not finite and >= 0.

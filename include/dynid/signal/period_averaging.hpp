@@ -6,6 +6,8 @@
 
 #include <Eigen/Core>
 
+#include "dynid/signal/periodic_filter.hpp"
+
 namespace dynid {
 
 /// Options of average_periods.
@@ -99,6 +101,20 @@ TimedPeriodAverage average_periods_in_time(const Eigen::Ref<const Eigen::VectorX
                                            const Eigen::Ref<const Eigen::MatrixXd>& x,
                                            double period,
                                            const TimedPeriodAverageOptions& options = {});
+
+/// Noise std of the mean period as a white noise at its own rate, for a raw white noise of std
+/// `raw_std` (ChannelNoise::std): raw_std·√(γ/(K·N)), K = `periods` averaged, N the decimation
+/// and γ the mean of |H|⁴ over the pass band [0, cut-off] of the circular low-pass of `lowpass`
+/// (lowpass_periodic(); null: no filter, N = γ = 1). Identity: in the band the mean's spectral
+/// density is the raw one over K times |H|⁴ (forward and backward pass), and a white noise of that
+/// density at the rate fs/N has variance raw_std²·γ/(K·N); this is the std that processed_noise()
+/// carries through identify's filter and differences when the mean period is the data
+/// (docs/methods/signal.md "Noise of the mean period"). γ: 1 for a Butterworth to 1e-2, about
+/// 1.12 for seed 2's 0.5 dB Chebyshev (unit DC gain at a ripple valley). Interpolation between
+/// samples does not change the density in the band. Throws dynid::Error for raw_std < 0 or not
+/// finite, periods < 1, and as design_lowpass().
+double averaged_noise_std(double raw_std, int periods,
+                          const PeriodicLowpassOptions* lowpass = nullptr);
 
 /// True for the name of a reference channel: qr<J>, dqr<J>, ddqr<J> (the controller's noise-free
 /// command and its analytic derivatives, as `dynid simulate` logs them).

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "dynid/signal/lowpass_design.hpp"
@@ -33,5 +35,22 @@ Eigen::MatrixXd filtfilt_periodic(const SosFilter& filter,
 /// above the decimated Nyquist rate sample_rate_hz/(2N) (aliasing), and as design_lowpass().
 Eigen::MatrixXd lowpass_periodic(const PeriodicLowpassOptions& options,
                                  const Eigen::Ref<const Eigen::MatrixXd>& x);
+
+/// One period after lowpass_periodic(): its kept rows.
+struct LowpassedPeriod {
+  Eigen::VectorXd phase;  ///< P/N phase times [s]: the input's rows 0, N, 2N, …
+  Eigen::MatrixXd x;      ///< P/N × c: the columns `filtered` low-passed, the others as given
+};
+
+/// The mean period x (P × c, phase times `phase`, P) with the columns listed in `filtered`
+/// passed through lowpass_periodic(options, ·) and every other column (a noise-free reference,
+/// kept with its analytic derivatives) and the phase taken at the same kept rows 0, N, 2N, …, so
+/// that every row of the result is one instant (seed 2 §3.4's filtered, resampled average).
+/// Throws dynid::Error for a phase that is not P long, a column index outside x, and as
+/// lowpass_periodic().
+LowpassedPeriod lowpass_period_columns(const PeriodicLowpassOptions& options,
+                                       const Eigen::Ref<const Eigen::VectorXd>& phase,
+                                       const Eigen::Ref<const Eigen::MatrixXd>& x,
+                                       const std::vector<Eigen::Index>& filtered);
 
 }  // namespace dynid
