@@ -145,9 +145,15 @@ void composite_rigid_body(const Model& model, Workspace& ws, Eigen::Ref<Eigen::M
     const double* const y = revolute ? n1 : f1;
     const double* const z = revolute ? n2 : f2;
     const double ax = a.x(), ay = a.y(), az = a.z();
-    for (int k = j; k < (parent < 0 ? j + 1 : end); ++k) {
-      if (!depth_first && !in_subtree(model, k, j)) continue;
-      M(k, j) = M(j, k) = ax * x[k] + ay * y[k] + az * z[k];
+    const int row_end = parent < 0 ? j + 1 : end;
+    if (depth_first && ax == 0.0 && ay == 0.0) {
+      // Axis ±z (every built-in robot): the same sum without its two zero terms.
+      for (int k = j; k < row_end; ++k) M(k, j) = M(j, k) = az * z[k];
+    } else {
+      for (int k = j; k < row_end; ++k) {
+        if (!depth_first && !in_subtree(model, k, j)) continue;
+        M(k, j) = M(j, k) = ax * x[k] + ay * y[k] + az * z[k];
+      }
     }
     M(j, j) += joint.friction.Ia;
     if (parent < 0) continue;
