@@ -1,5 +1,7 @@
 #include "dynid/dynamics/workspace.hpp"
 
+#include <algorithm>
+
 namespace dynid {
 
 Workspace::Workspace(const Model& model)
@@ -7,6 +9,8 @@ Workspace::Workspace(const Model& model)
       ancestors(model.dof()),
       twists(model.dof()),
       composite(model.dof()),
+      subtree_end(model.dof()),
+      forces(model.dof(), 6),
       scratch_nn(model.dof(), model.dof()),
       scratch_n(model.dof()),
       scratch_n2(model.dof()) {
@@ -14,6 +18,16 @@ Workspace::Workspace(const Model& model)
     for (int i = j; i >= 0; i = model.joints[i].parent) ancestors[j].push_back(i);
     twists[j].resize(ancestors[j].size());
   }
+  std::vector<int> size(model.dof(), 1);
+  for (int j = model.dof() - 1; j >= 0; --j) {
+    subtree_end[j] = std::max(subtree_end[j], j + 1);
+    const int p = model.joints[j].parent;
+    if (p >= 0) {
+      subtree_end[p] = std::max(subtree_end[p], subtree_end[j]);
+      size[p] += size[j];
+    }
+  }
+  for (int j = 0; j < model.dof(); ++j) depth_first &= subtree_end[j] - j == size[j];
 }
 
 }  // namespace dynid

@@ -44,9 +44,14 @@ struct Workspace {
   /// twists[j][k]: unit twist (ω; v at origin j) of joint ancestors[j][k], expressed in frame j.
   std::vector<std::vector<Eigen::Matrix<double, 6, 1>>> twists;
   std::vector<BodyInertia> composite;  ///< composite inertias of the subtrees (CRBA)
-  Eigen::MatrixXd scratch_nn;          ///< n×n scratch (mass matrix, its LᵀDL factor)
-  Eigen::VectorXd scratch_n;           ///< n scratch
-  Eigen::VectorXd scratch_n2;          ///< n scratch
+  /// subtree_end[j]: one past the last descendant of joint j (parents precede children), so the
+  /// subtree of j lies in [j, subtree_end[j]); it is exactly that range when `depth_first`.
+  std::vector<int> subtree_end;
+  bool depth_first = true;     ///< joints in depth-first order: every subtree is a contiguous range
+  Eigen::MatrixXd forces;      ///< n×6 CRBA column forces (n; f), one column per component
+  Eigen::MatrixXd scratch_nn;  ///< n×n scratch (mass matrix, its LᵀDL factor)
+  Eigen::VectorXd scratch_n;   ///< n scratch
+  Eigen::VectorXd scratch_n2;  ///< n scratch
 };
 
 }  // namespace dynid
