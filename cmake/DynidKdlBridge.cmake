@@ -29,3 +29,12 @@ target_include_directories(dynid_kdl_bridge SYSTEM PRIVATE
   ${orocos_kdl_INCLUDE_DIRS} ${KDL_PARSER_INCLUDE_DIR})
 target_link_libraries(dynid_kdl_bridge PRIVATE Eigen3::Eigen ${orocos_kdl_LIBRARIES}
   ${KDL_PARSER_LIBRARY})
+
+# Links `target` to the bridge, keeping the executable's Eigen symbols out of its dynamic symbol
+# table (cmake/hide_eigen.map says why).
+function(dynid_link_kdl_bridge target)
+  target_link_libraries(${target} PRIVATE dynid_kdl_bridge)
+  target_link_options(${target} PRIVATE
+    "-Wl,--version-script=${PROJECT_SOURCE_DIR}/cmake/hide_eigen.map")
+  set_property(TARGET ${target} APPEND PROPERTY LINK_DEPENDS ${PROJECT_SOURCE_DIR}/cmake/hide_eigen.map)
+endfunction()
