@@ -3,14 +3,13 @@
 // chain is parsed from dynid's URDF export of the built-in model). Run:
 // ./build/bench/dynamics_bench --benchmark_repetitions=5
 // --benchmark_report_aggregates_only=true
+#include <map>
+#include <memory>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 #include <benchmark/benchmark.h>
-#include <kdl/chaindynparam.hpp>
-#include <kdl/chainfdsolver_recursive_newton_euler.hpp>
-#include <kdl/chainidsolver_recursive_newton_euler.hpp>
-#include <kdl/tree.hpp>
-#include <kdl_parser/kdl_parser.hpp>
 
 #include "dynid/dynamics/mass_matrix.hpp"
 #include "dynid/dynamics/rnea.hpp"
@@ -18,6 +17,7 @@
 #include "dynid/model/robots.hpp"
 #include "dynid/regressor/energy_regressor.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
+#include "oracle/kdl_bridge.hpp"
 
 namespace {
 
@@ -121,74 +121,62 @@ void BM_EnergyRegressor(benchmark::State& st, const std::string& name) {
   }
 }
 
-// The KDL chain of a built-in robot, parsed from dynid's URDF export (false if parsing failed).
-bool kdl_chain(const Model& model, KDL::Chain& chain) {
-  KDL::Tree tree;
-  if (!kdl_parser::treeFromString(dynid::to_urdf(model), tree)) return false;
-  return tree.getChain("base_link", model.joints.back().link_name, chain);
+// The KDL chain of a built-in robot, parsed from dynid's URDF export, behind the Eigen-free
+// bridge (tests/oracle/kdl_bridge.hpp, for the native preset): each call copies n doubles in and
+// out of KDL's JntArrays, a few ns against KDL's µs. Null if parsing failed.
+std::unique_ptr<dynid::kdl::Chain> kdl_chain(const Model& model) {
+  try {
+    return std::make_unique<dynid::kdl::Chain>(dynid::to_urdf(model), dynid::kdl::UrdfSource::kText,
+                                               "base_link", model.joints.back().link_name,
+                                               model.gravity.data());
+  } catch (const std::exception&) {
+    return nullptr;
+  }
 }
 
 void BM_KdlMass(benchmark::State& st, const std::string& name) {
   const Model& model = robot(name);
-  KDL::Chain chain;
-  if (!kdl_chain(model, chain)) {
+  const auto chain = kdl_chain(model);
+  if (!chain) {
     st.SkipWithError("kdl_parser failed");
     return;
   }
-  KDL::ChainDynParam solver(chain,
-                            KDL::Vector(model.gravity.x(), model.gravity.y(), model.gravity.z()));
   const int n = model.dof();
   const State s(n);
-  KDL::JntArray q(n);
-  q.data = s.q;
-  KDL::JntSpaceInertiaMatrix H(n);
+  Eigen::MatrixXd H(n, n);
   for (auto _ : st) {
-    solver.JntToMass(q, H);
-    benchmark::DoNotOptimize(H.data.data());
+    chain->mass_matrix(s.q.data(), H.data());
+    benchmark::DoNotOptimize(H.data());
   }
 }
 
 void BM_KdlForwardDynamics(benchmark::State& st, const std::string& name) {
   const Model& model = robot(name);
-  KDL::Chain chain;
-  if (!kdl_chain(model, chain)) {
+  const auto chain = kdl_chain(model);
+  if (!chain) {
     st.SkipWithError("kdl_parser failed");
     return;
   }
-  KDL::ChainFdSolver_RNE solver(
-      chain, KDL::Vector(model.gravity.x(), model.gravity.y(), model.gravity.z()));
-  const int n = model.dof();
-  const State s(n);
-  KDL::JntArray q(n), dq(n), tau(n), ddq(n);
-  q.data = s.q;
-  dq.data = s.dq;
-  tau.data = s.ddq;
-  KDL::Wrenches f_ext(chain.getNrOfSegments(), KDL::Wrench::Zero());
+  const State s(model.dof());
+  Eigen::VectorXd ddq(model.dof());
   for (auto _ : st) {
-    solver.CartToJnt(q, dq, tau, f_ext, ddq);
-    benchmark::DoNotOptimize(ddq.data.data());
+    chain->forward_dynamics(s.q.data(), s.dq.data(), s.ddq.data(), ddq.data());
+    benchmark::DoNotOptimize(ddq.data());
   }
 }
 
 void BM_KdlRne(benchmark::State& st, const std::string& name) {
   const Model& model = robot(name);
-  KDL::Chain chain;
-  if (!kdl_chain(model, chain)) {
+  const auto chain = kdl_chain(model);
+  if (!chain) {
     st.SkipWithError("kdl_parser failed");
     return;
   }
-  KDL::ChainIdSolver_RNE solver(
-      chain, KDL::Vector(model.gravity.x(), model.gravity.y(), model.gravity.z()));
-  const int n = model.dof();
-  const State s(n);
-  KDL::JntArray q(n), dq(n), ddq(n), tau(n);
-  q.data = s.q;
-  dq.data = s.dq;
-  ddq.data = s.ddq;
-  KDL::Wrenches f_ext(chain.getNrOfSegments(), KDL::Wrench::Zero());
+  const State s(model.dof());
+  Eigen::VectorXd tau(model.dof());
   for (auto _ : st) {
-    solver.CartToJnt(q, dq, ddq, f_ext, tau);
-    benchmark::DoNotOptimize(tau.data.data());
+    chain->inverse_dynamics(s.q.data(), s.dq.data(), s.ddq.data(), tau.data());
+    benchmark::DoNotOptimize(tau.data());
   }
 }
 

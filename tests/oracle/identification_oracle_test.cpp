@@ -6,13 +6,11 @@
 #include <random>
 
 #include <gtest/gtest.h>
-#include <kdl/chainidsolver_recursive_newton_euler.hpp>
-#include <kdl/tree.hpp>
-#include <kdl_parser/kdl_parser.hpp>
 
 #include "dynid/estimation/identification.hpp"
 #include "dynid/io/urdf_writer.hpp"
 #include "dynid/model/robots.hpp"
+#include "oracle/kdl_bridge.hpp"
 
 namespace dynid {
 namespace {
@@ -46,21 +44,16 @@ JointRecord excite(int n, double duration, double rate, unsigned seed, double ji
 // tau from KDL's ChainIdSolver_RNE on dynid's URDF export, plus the joint friction and armature
 // terms written out here from their definition (seed 1 eq. 3).
 Eigen::MatrixXd kdl_torques(const Model& model, const JointRecord& r) {
-  KDL::Tree tree;
-  EXPECT_TRUE(kdl_parser::treeFromString(to_urdf(model), tree));
-  KDL::Chain chain;
-  EXPECT_TRUE(tree.getChain("base_link", model.joints.back().link_name, chain));
-  KDL::ChainIdSolver_RNE solver(
-      chain, KDL::Vector(model.gravity.x(), model.gravity.y(), model.gravity.z()));
+  kdl::Chain chain(to_urdf(model), kdl::UrdfSource::kText, "base_link",
+                   model.joints.back().link_name, model.gravity.data());
   const int n = model.dof();
-  KDL::JntArray q(n), dq(n), ddq(n), tau(n);
-  KDL::Wrenches f_ext(chain.getNrOfSegments(), KDL::Wrench::Zero());
+  Eigen::VectorXd q(n), dq(n), ddq(n), tau(n);
   Eigen::MatrixXd out(r.q.rows(), n);
   for (Eigen::Index i = 0; i < r.q.rows(); ++i) {
-    q.data = r.q.row(i).transpose();
-    dq.data = r.dq.row(i).transpose();
-    ddq.data = r.ddq.row(i).transpose();
-    solver.CartToJnt(q, dq, ddq, f_ext, tau);
+    q = r.q.row(i).transpose();
+    dq = r.dq.row(i).transpose();
+    ddq = r.ddq.row(i).transpose();
+    chain.inverse_dynamics(q.data(), dq.data(), ddq.data(), tau.data());
     for (int j = 0; j < n; ++j) {
       const JointFriction& f = model.joints[j].friction;
       const double v = r.dq(i, j);

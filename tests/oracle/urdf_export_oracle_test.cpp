@@ -7,8 +7,6 @@
 
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
-#include <kdl/treeidsolver_recursive_newton_euler.hpp>
-#include <kdl_parser/kdl_parser.hpp>
 
 #include "dynid/dynamics/rnea.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
@@ -17,7 +15,7 @@
 #include "dynid/model/robots.hpp"
 #include "dynid/model/urdf_loader.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
-#include "oracle/kdl_support.hpp"
+#include "oracle/kdl_bridge.hpp"
 #include "oracle/oracle_support.hpp"
 #include "support/random_models.hpp"
 
@@ -87,10 +85,10 @@ TEST_P(UrdfExportOracle, ExportedUrdfPredictsTheIdentifiedBaseModel) {
 
   const Model reloaded = load_urdf(path);
   ASSERT_EQ(reloaded.dof(), n);
-  KDL::Tree tree;
-  ASSERT_TRUE(kdl_parser::treeFromString(exported.text, tree));
-  const std::vector<unsigned> idx = testing::kdl_indices(tree, reloaded);
-  KDL::TreeIdSolver_RNE kdl(tree, KDL::Vector(0.0, 0.0, -9.81));
+  std::vector<std::string> names;
+  for (const Joint& j : reloaded.joints) names.push_back(j.name);
+  const double gravity[3] = {0.0, 0.0, -9.81};
+  kdl::Tree kdl(exported.text, kdl::UrdfSource::kText, names, gravity);
   char error[1000] = "";
   std::unique_ptr<mjModel, MujocoDeleter> mj(mj_loadXML(path.c_str(), nullptr, error, 1000));
   std::remove(path.c_str());
@@ -124,14 +122,7 @@ TEST_P(UrdfExportOracle, ExportedUrdfPredictsTheIdentifiedBaseModel) {
     tau += joint_terms(exported.model, dq, ddq, true, false, false);
     worst_dynid = std::max(worst_dynid, (tau - tau_base).norm() / tau_base.norm());
 
-    KDL::JntArray kq(n), kdq(n), kddq(n), ktau(n);
-    for (int j = 0; j < n; ++j) {
-      kq(idx[j]) = q[j];
-      kdq(idx[j]) = dq[j];
-      kddq(idx[j]) = ddq[j];
-    }
-    ASSERT_GE(kdl.CartToJnt(kq, kdq, kddq, KDL::WrenchMap(), ktau), 0);
-    for (int j = 0; j < n; ++j) tau[j] = ktau(idx[j]);
+    ASSERT_GE(kdl.inverse_dynamics(q.data(), dq.data(), ddq.data(), tau.data()), 0);
     tau += joint_terms(exported.model, dq, ddq, true, true, true);
     worst_kdl = std::max(worst_kdl, (tau - tau_base).norm() / tau_base.norm());
 
