@@ -148,6 +148,46 @@ TEST(ControllerChoice, NewRuleBoundsTheCoupledModeAndTheLag) {
             std::string::npos);
 }
 
+// Largest sample-to-sample change of any logged torque after a 1 mrad step of joint 1's reference
+// at 0.5 s, planar2 held at elbow angle q2 by the default delay-free feed-forward loop (2 s, one
+// period). A stable loop's largest change is the proportional kick kp1·1 mrad at the step; an
+// unstable mode grows from it instead (chatter, docs/methods/sim.md "torque chatter").
+double torque_jump_after_step(double q2, double* kick) {
+  const Model model = load_robot("planar2");
+  const int m = static_cast<int>(2 * kRate);
+  Eigen::VectorXd t(m);
+  Eigen::MatrixXd q(m, 2), zero = Eigen::MatrixXd::Zero(m, 2);
+  for (int k = 0; k < m; ++k) {
+    t[k] = k / kRate;
+    q.row(k) << 0.2 + (k >= m / 4 ? 1e-3 : 0.0), q2;
+  }
+  SimulateOptions o;
+  o.loop.periods = 1;
+  PidOptions used;
+  const ClosedLoopResult r = simulate_reference(model, t, q, zero, zero, o, &used);
+  *kick = used.kp[0] * 1e-3;
+  return (r.tau.bottomRows(m - 1) - r.tau.topRows(m - 1)).cwiseAbs().maxCoeff();
+}
+
+TEST(ControllerChoice, FeedForwardLoopIsStableWithTheElbowBent) {
+  // Positive control of the test below: at q2 = 1 rad the loop holds (measured: 3.1 N·m, kick
+  // 3.6 N·m).
+  double kick = 0.0;
+  const double jump = torque_jump_after_step(1.0, &kick);
+  EXPECT_LE(jump, 2.0 * kick);
+}
+
+// KNOWN LIMITATION (the chatter of the excite → simulate → identify chain, left for the gain-rule
+// decision, docs/methods/sim.md): the historical delay-free feed-forward gains ∝ diag(M(q0)) leave
+// planar2's coupled mode unstable for |q2| < 0.58 rad (spectral radius up to 1.052 per sample); at
+// q2 = 0 the 1 mrad step grows to 3.8e3 N·m swings in 1.5 s, on both engines. Enable once the rule
+// holds it (gains ÷ μ_max as for the delayed loop do).
+TEST(ControllerChoice, DISABLED_FeedForwardLoopIsStableWithTheArmStretched) {
+  double kick = 0.0;
+  const double jump = torque_jump_after_step(0.0, &kick);
+  EXPECT_LE(jump, 2.0 * kick);
+}
+
 class GainsFile : public ::testing::Test {
  protected:
   void SetUp() override {
