@@ -10,10 +10,10 @@
 //   JSON null appears only where the model JSON documents it (root parent, unlimited limits).
 // The mutations are drawn from a fixed seed, so every case is the same on every run. Each command
 // is one test; a failing case is reported with its command line and the folder holding its inputs
-// (kept under $TMPDIR/dynid_cli_fuzz/, with replay.sh and `args`) so that it can be replayed by
-// hand or recorded. The recorded
-// reproducers of fuzz/regressions/commands/ (one folder each: `args`, one argument a line with
-// the escapes \\, \n, \t and \xNN, and the files it reads) are replayed under the same contract.
+// (kept under $TMPDIR/dynid_cli_fuzz/COMMAND.PID/, with replay.sh and `args`) so that it can be
+// replayed by hand or recorded. The recorded reproducers of fuzz/regressions/commands/ (one folder
+// each: `args`, one argument a line with the escapes \\, \n, \t and \xNN, and the files it reads)
+// are replayed under the same contract.
 
 #include <fcntl.h>
 #include <signal.h>
@@ -573,7 +573,9 @@ class CliFuzz : public ::testing::Test {
   /// mutated ones; every run must keep the contract.
   void fuzz(const Command& command, unsigned seed) {
     ASSERT_TRUE(base_ok_) << "could not make the base run: " << base_error_;
-    const fs::path keep = fs::temp_directory_path() / "dynid_cli_fuzz" / command.name;
+    // One folder per process: ctest runs of two build trees at once must not share it.
+    const fs::path keep = fs::temp_directory_path() / "dynid_cli_fuzz" /
+                          (command.name + "." + std::to_string(::getpid()));
     fs::remove_all(keep);
     Rng rng(seed);
     int failed = 0;
@@ -631,6 +633,7 @@ class CliFuzz : public ::testing::Test {
     }
     std::cout << command.name << ": " << failed << " of " << command.cases + 1
               << " runs broke the contract\n";
+    if (failed == 0) fs::remove_all(keep);  // only failing cases are kept, for replay
   }
 
   static inline fs::path root_;
@@ -756,7 +759,8 @@ TEST_F(CliFuzz, Demo) {
 TEST(CliFuzzRegressions, RecordedReproducersKeepTheContract) {
   const fs::path recorded = fs::path(DYNID_SOURCE_DIR) / "fuzz/regressions/commands";
   ASSERT_TRUE(fs::is_directory(recorded)) << recorded;
-  const fs::path keep = fs::temp_directory_path() / "dynid_cli_fuzz" / "regressions";
+  const fs::path keep =
+      fs::temp_directory_path() / "dynid_cli_fuzz" / ("regressions." + std::to_string(::getpid()));
   fs::remove_all(keep);
   int replayed = 0;
   for (const auto& entry : fs::directory_iterator(recorded)) {
@@ -779,6 +783,7 @@ TEST(CliFuzzRegressions, RecordedReproducersKeepTheContract) {
                   << "\n    inputs: " << dir.string();
   }
   EXPECT_GT(replayed, 0);
+  if (!HasFailure()) fs::remove_all(keep);
 }
 
 }  // namespace
