@@ -29,6 +29,7 @@
 #include <iostream>
 #include <memory>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -105,11 +106,9 @@ int run(const std::string& out_path) {
   plant_options.dt = kDt;
   std::unique_ptr<Plant> plant = make_plant(nominal, plant_options);
 
-  std::ofstream csv(out_path);
-  if (!csv) {
-    std::cerr << "error: cannot write " << out_path << "; give a writable OUT.csv\n";
-    return 1;
-  }
+  // The rows are kept in memory (800 lines) and written at the end, so that a run that fails
+  // leaves no partial file.
+  std::ostringstream csv;
   csv << "t,tracking_error,prediction_error,payload_effect\n";
 
   Workspace ws(nominal);
@@ -162,10 +161,15 @@ int run(const std::string& out_path) {
       sums.assign(3, 0.0);
     }
   }
-  csv.close();
-  if (!csv) {
-    std::cerr << "error: writing " << out_path << " failed; check the disk\n";
-    return 1;
+  {
+    std::ofstream file(out_path);
+    file << csv.str();
+    file.close();
+    if (!file) {
+      std::remove(out_path.c_str());
+      std::cerr << "error: cannot write " << out_path << "; give a writable OUT.csv\n";
+      return 1;
+    }
   }
 
   // Settled: the first time after the pick-up from which every 100 ms average of the prediction

@@ -106,7 +106,7 @@ CsvChunkReader::CsvChunkReader(const std::string& path, const CsvChunkOptions& o
   impl_->file = std::fopen(path.c_str(), "rb");
   if (impl_->file == nullptr) {
     throw Error(path + ": cannot open (" + std::strerror(errno) +
-                "); check the path given to --in");
+                "); check the path and that the file is readable");
   }
   // First read: skip a byte-order mark (the line terminator is learnt by next_line).
   Impl& s = *impl_;
@@ -263,7 +263,7 @@ CsvBlockReader::CsvBlockReader(const std::string& path, const CsvBlockOptions& o
   struct stat st {};
   if (s.fd < 0 || ::fstat(s.fd, &st) != 0) {
     throw Error(path + ": cannot open (" + std::strerror(errno) +
-                "); check the path given to --in");
+                "); check the path and that the file is readable");
   }
   if (!S_ISREG(st.st_mode)) {
     throw Error(path + ": not a regular file; give the path of a CSV file");
