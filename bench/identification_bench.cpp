@@ -11,8 +11,8 @@
 #include <benchmark/benchmark.h>
 
 #include "dynid/dynamics/rnea.hpp"
+#include "dynid/identification/streaming_identification.hpp"
 #include "dynid/io/csv_writer.hpp"
-#include "dynid/io/streaming_identification.hpp"
 #include "dynid/model/robots.hpp"
 
 namespace {

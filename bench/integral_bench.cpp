@@ -7,7 +7,7 @@
 
 #include <benchmark/benchmark.h>
 
-#include "dynid/estimation/integral_equations.hpp"
+#include "dynid/identification/integral_equations.hpp"
 #include "dynid/model/robots.hpp"
 
 namespace {

@@ -29,10 +29,11 @@
 #include <Eigen/QR>
 #include <Eigen/SVD>
 
-#include "../tests/estimation/integral_support.hpp"
-#include "dynid/estimation/identification.hpp"
-#include "dynid/estimation/integral_equations.hpp"
+#include "../tests/identification/integral_support.hpp"
 #include "dynid/estimation/least_squares.hpp"
+#include "dynid/identification/identify.hpp"
+#include "dynid/identification/integral_equations.hpp"
+#include "dynid/identification/validation.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/regressor/energy_regressor.hpp"
 

@@ -12,10 +12,11 @@
 #include <cstdlib>
 #include <vector>
 
-#include "../tests/estimation/integral_support.hpp"
-#include "dynid/estimation/identification.hpp"
-#include "dynid/estimation/integral_equations.hpp"
+#include "../tests/identification/integral_support.hpp"
 #include "dynid/estimation/least_squares.hpp"
+#include "dynid/identification/identify.hpp"
+#include "dynid/identification/integral_equations.hpp"
+#include "dynid/identification/validation.hpp"
 #include "dynid/model/robots.hpp"
 
 namespace {
@@ -27,8 +28,8 @@ double g_noise = 1.0, g_torque_noise = 1.0;
 const std::vector<double> kCutoffs = {0.0, 2.0, 5.0, 10.0, 20.0, 40.0, 80.0, -1.0};
 const std::vector<double> kIntervalsMs = {0.0, 5.0, 10.0, 50.0, 100.0, 200.0, 500.0, 1000.0};
 
-// The closed-loop run of the tests (tests/estimation/integral_support.hpp): PID + computed-torque
-// feed-forward tracking one multi-sine period twice.
+// The closed-loop run of the tests (tests/identification/integral_support.hpp): PID +
+// computed-torque feed-forward tracking one multi-sine period twice.
 JointRecord run(const Model& model, unsigned seed, double ts) {
   SensorOptions so;
   so.position_noise_std = 1e-4 * g_noise;

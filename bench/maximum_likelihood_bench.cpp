@@ -9,8 +9,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include "dynid/closed_loop/maximum_likelihood.hpp"
 #include "dynid/estimation/least_squares.hpp"
-#include "dynid/estimation/maximum_likelihood.hpp"
 #include "dynid/excitation/fourier_trajectory.hpp"
 #include "dynid/excitation/trajectory_samples.hpp"
 #include "dynid/identifiability/base_parameters.hpp"

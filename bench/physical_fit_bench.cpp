@@ -9,11 +9,11 @@
 #include <benchmark/benchmark.h>
 
 #include "dynid/dynamics/rnea.hpp"
-#include "dynid/estimation/identification.hpp"
-#include "dynid/estimation/physical_parameters.hpp"
+#include "dynid/identification/identify.hpp"
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/model/transmission.hpp"
+#include "dynid/physical/physical_parameters.hpp"
 
 namespace {
 

@@ -9,7 +9,7 @@
 
 #include <benchmark/benchmark.h>
 
-#include "dynid/estimation/projection.hpp"
+#include "dynid/closed_loop/projection.hpp"
 
 namespace {
 

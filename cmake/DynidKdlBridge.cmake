@@ -2,7 +2,7 @@
 # by oracle_tests and bench/dynamics_bench. Debian's KDL is built for plain x86-64 and passes Eigen
 # objects through its API; under the `native` preset dynid's Eigen aligns its heap blocks to
 # 32/64 bytes by its own allocator, so a JntArray made on one side and freed on the other corrupts
-# the heap (DESIGN.md section 1). The bridge is therefore
+# the heap (docs/design.md section 1). The bridge is therefore
 # - compiled without the native flags, so its Eigen agrees with KDL's;
 # - a SHARED library with hidden symbols: its Eigen template instances (compiled without AVX)
 #   stay inside it, where a static library would let the linker merge them (COMDAT) with the

@@ -16,19 +16,21 @@
 
 #include "dynid/common/error.hpp"
 #include "dynid/dynamics/rnea.hpp"
-#include "dynid/estimation/identification.hpp"
-#include "dynid/estimation/load_identification.hpp"
-#include "dynid/estimation/physical_parameters.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
+#include "dynid/identification/identify.hpp"
+#include "dynid/identification/validation.hpp"
 #include "dynid/io/atomic_file.hpp"
 #include "dynid/io/model_summary.hpp"
-#include "dynid/io/urdf_export.hpp"
+#include "dynid/load/load_identification.hpp"
 #include "dynid/model/robots.hpp"
+#include "dynid/physical/physical_parameters.hpp"
+#include "dynid/physical/urdf_export.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
 #include "dynid/report/experiment_report.hpp"
 #include "dynid/report/html_report.hpp"
 #include "dynid/report/identification_report.hpp"
 #include "dynid/report/payload_report.hpp"
+#include "dynid/report/stored_result.hpp"
 #include "dynid/version.hpp"
 
 namespace py = pybind11;
@@ -366,51 +368,9 @@ nlohmann::json payload_from_orientation(const std::optional<Eigen::VectorXd>& t,
 }
 
 // The identify options that rebuild a result's regressor and filtering, as `dynid validate` and
-// `dynid payload --reference result.json` read the file: friction set, armature, filter,
-// Savitzky-Golay and filtered Coulomb columns from its `options` (a dynid.identify dict or the
-// command line's result.json), the cut-off and zero-velocity thresholds identify used.
-IdentifyOptions options_of_result(const IdentifiedResultFile& identified) {
-  const nlohmann::json& o = identified.options;
-  const auto flag = [&](const char* key, bool fallback) {
-    return o.contains(key) && o[key].is_boolean() ? o[key].get<bool>() : fallback;
-  };
-  IdentifyOptions options;
-  if (o.contains("friction") && o["friction"].is_string()) {  // the command line's --friction
-    const std::string friction = o["friction"].get<std::string>();
-    const auto has = [&](const char* term) { return friction.find(term) != std::string::npos; };
-    const bool asymmetric = has("asymmetric");
-    options.layout = layout_of(flag("armature", true), has("viscous"), has("coulomb"),
-                               has("offset"), asymmetric);
-  } else {
-    options.layout = layout_of(flag("armature", true), flag("viscous", true), flag("coulomb", true),
-                               flag("offset", true), flag("asymmetric", false));
-  }
-  if (o.contains("filter") && o["filter"].is_string()) {  // the command line's --filter
-    const std::string filter = o["filter"].get<std::string>();
-    if (filter != "auto" && filter != "none") {
-      throw Error("the result was filtered with --filter " + filter +
-                  ", which only the command line rebuilds; use dynid validate or dynid payload "
-                  "--reference result.json");
-    }
-    options.signal.filter = filter == "auto";
-  } else {
-    options.signal.filter = flag("filter", true);
-  }
-  options.signal.savitzky_golay = flag("savitzky_golay", false);
-  options.signal.filter_coulomb_columns = flag("filter_coulomb_columns", false);
-  options.signal.cutoff_hz =
-      identified.cutoff_hz > 0.0
-          ? identified.cutoff_hz
-          : (o.contains("cutoff_hz") && o["cutoff_hz"].is_number() ? o["cutoff_hz"].get<double>()
-                                                                   : 0.0);
-  if (!identified.zero_velocity_threshold.empty()) {
-    options.signal.zero_velocity = identified.zero_velocity_threshold;
-  } else if (o.contains("zero_velocity") && o["zero_velocity"].is_array()) {
-    options.signal.zero_velocity = o["zero_velocity"].get<std::vector<double>>();
-  }
-  if (o.contains("torque_offset_s") && o["torque_offset_s"].is_number())
-    options.signal.torque_time_offset = o["torque_offset_s"].get<double>();
-  return options;
+// `dynid payload --reference result.json` read the file (options_of_stored_result).
+IdentifyOptions options_of_result(const Model& model, const IdentifiedResultFile& identified) {
+  return options_of_stored_result(identified, "result", model.dof()).options;
 }
 
 // An identify result dict (dynid.identify's, or a result.json loaded with json.load) read with
@@ -462,7 +422,7 @@ nlohmann::json payload_from_torques(const Model& model, const std::string& link_
           "identify filtered the unloaded one); drop them");
     }
     const IdentifiedResultFile identified = identified_result(model, reference, "reference");
-    const IdentifyOptions identify = options_of_result(identified);
+    const IdentifyOptions identify = options_of_result(model, identified);
     // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
     options.hac_covariance = identify.signal.filter;
     {
@@ -544,7 +504,8 @@ PYBIND11_MODULE(dynid, m) {
   using namespace dynid;
   m.doc() =
       "dynid: identification of robot dynamic parameters (link inertias, actuator inertias, joint "
-      "friction). Units SI; parameter names and order as in dynid's DESIGN.md section 3. Arrays "
+      "friction). Units SI; parameter names and order as in dynid's docs/design.md section 3. "
+      "Arrays "
       "of samples are (samples x joints) float64.";
   m.attr("__version__") = kVersion;
   py::register_exception<Error>(m, "Error", PyExc_ValueError);
@@ -681,7 +642,7 @@ PYBIND11_MODULE(dynid, m) {
         const IdentifiedResultFile identified = identified_result(model, result, "result");
         nlohmann::json used;
         const IdentifyOptions options =
-            kw.empty() ? options_of_result(identified) : identify_options(kw, used);
+            kw.empty() ? options_of_result(model, identified) : identify_options(kw, used);
         const JointRecord record = record_of(model, t, q, tau, dq, ddq);
         ValidationResult v;
         {

@@ -11,7 +11,8 @@
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
-#include "dynid/estimation/identification.hpp"
+#include "dynid/identification/identify.hpp"
+#include "dynid/identification/option_text.hpp"
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/io/csv_writer.hpp"
 #include "dynid/io/json_writer.hpp"
@@ -36,7 +37,7 @@ void run(const AverageCliOptions& o) {
   if (o.skip_periods < 0) throw UsageError("--skip-periods must be >= 0");
   const double period = o.period > 0.0 ? o.period : 1.0 / o.f0;
   SignalOptions filter;
-  parse_filter(o.filter, filter);
+  apply_filter_text(o.filter, filter);
   const bool filtered = o.filter != "none";
   if (o.filter == "auto")
     throw UsageError(

@@ -11,6 +11,7 @@
 #include "dynid/io/json_writer.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/report/control_report.hpp"
+#include "dynid/report/stored_result.hpp"
 #include "dynid/sim/control_comparison.hpp"
 #include "dynid/sim/pid_gains.hpp"
 

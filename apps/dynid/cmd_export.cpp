@@ -6,8 +6,8 @@
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
 #include "dynid/io/atomic_file.hpp"
-#include "dynid/io/urdf_export.hpp"
 #include "dynid/model/robots.hpp"
+#include "dynid/physical/urdf_export.hpp"
 #include "flag_checks.hpp"
 
 namespace dynid::cli {

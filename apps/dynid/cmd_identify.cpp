@@ -14,24 +14,27 @@
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
 #include "dynid/common/progress.hpp"
-#include "dynid/estimation/completed_model.hpp"
-#include "dynid/estimation/decoupled_model.hpp"
-#include "dynid/estimation/friction_experiment.hpp"
-#include "dynid/estimation/gravity_experiment.hpp"
-#include "dynid/estimation/physical_parameters.hpp"
+#include "dynid/experiments/decoupled_model.hpp"
+#include "dynid/experiments/friction_experiment.hpp"
+#include "dynid/experiments/gravity_experiment.hpp"
+#include "dynid/identification/streaming_identification.hpp"
+#include "dynid/identification/identify.hpp"
+#include "dynid/identification/validation.hpp"
 #include "dynid/io/closed_loop_file.hpp"
 #include "dynid/io/joint_record_file.hpp"
 #include "dynid/io/json_writer.hpp"
-#include "dynid/io/streaming_identification.hpp"
 #include "dynid/model/robots.hpp"
+#include "dynid/physical/completed_model.hpp"
+#include "dynid/physical/identified_model.hpp"
+#include "dynid/physical/physical_parameters.hpp"
 #include "dynid/report/control_report.hpp"
 #include "dynid/report/experiment_report.hpp"
 #include "dynid/report/html_report.hpp"
 #include "dynid/report/identification_report.hpp"
+#include "dynid/report/stored_result.hpp"
 #include "dynid/sim/pid_gains.hpp"
 #include "dynid/sim/simulate_reference.hpp"
 #include "flag_checks.hpp"
-#include "result_options.hpp"
 
 namespace dynid::cli {
 namespace {
@@ -153,52 +156,7 @@ std::vector<std::string> split(const std::string& text, char sep) {
   return out;
 }
 
-ParameterLayout parse_friction(const std::string& text, bool armature) {
-  ParameterLayout layout;
-  layout.armature = armature;
-  if (text == "none") return layout;
-  for (const auto& item : split(text, ',')) {
-    if (item == "viscous") {
-      layout.viscous = true;
-    } else if (item == "coulomb") {
-      layout.coulomb = true;
-    } else if (item == "offset") {
-      layout.offset = true;
-    } else if (item == "asymmetric") {
-      layout.viscous = layout.coulomb = layout.asymmetric = true;
-    } else {
-      throw UsageError("--friction: unknown term '" + item +
-                       "'; use a comma list of viscous, coulomb, offset, asymmetric, or none");
-    }
-  }
-  return layout;
-}
-
 }  // namespace
-
-// --filter auto | none | butterworth[:ORDER] | chebyshev[:ORDER[:RIPPLE_DB]] (commands.hpp;
-// dynid average uses it too).
-void parse_filter(const std::string& text, SignalOptions& s) {
-  const auto parts = split(text, ':');
-  const std::string kind = parts.empty() ? "" : parts[0];
-  try {
-    if (kind == "auto") return;
-    if (kind == "none") {
-      s.filter = false;
-    } else if (kind == "butterworth" || kind == "chebyshev") {
-      s.family = kind == "butterworth" ? LowpassFamily::kButterworth : LowpassFamily::kChebyshev1;
-      if (kind == "chebyshev") s.order = 8;  // seed 2 §3.4
-      if (parts.size() > 1) s.order = std::stoi(parts[1]);
-      if (parts.size() > 2) s.ripple_db = std::stod(parts[2]);
-    } else {
-      throw UsageError("");
-    }
-  } catch (const std::exception&) {
-    throw UsageError("--filter '" + text +
-                     "' is not understood; use auto, none, butterworth[:ORDER] or "
-                     "chebyshev[:ORDER[:RIPPLE_DB]] (the cut-off is --cutoff)");
-  }
-}
 
 namespace {
 
@@ -212,13 +170,13 @@ IdentificationEstimator parse_estimator(const std::string& text) {
 
 IdentifyOptions library_options(const IdentifyCliOptions& o) {
   IdentifyOptions out;
-  out.layout = parse_friction(o.friction, !o.no_armature);
+  out.layout = friction_layout(o.friction, !o.no_armature);
   out.estimator = parse_estimator(o.estimator);
   out.confidence_level = o.confidence;
   if (!(o.confidence > 0.0 && o.confidence < 1.0)) {
     throw UsageError("--confidence must be in (0, 1), e.g. 0.999");
   }
-  parse_filter(o.filter, out.signal);
+  apply_filter_text(o.filter, out.signal);
   out.signal.cutoff_hz = o.cutoff;
   out.signal.decimate = o.decimate;
   out.signal.trim = o.trim;
@@ -382,63 +340,6 @@ void warn_identify_no_effect(const IdentifyCliOptions& o, const CLI::App& cmd) {
     if (cmd.count(flag)) warn(std::string(flag) + " has no effect with --closed-loop" + why);
 }
 
-// The options a result JSON records, read with the file and key named in any error (a wrong type
-// is the file's fault, not a command-line flag's).
-struct FileOptions {
-  const nlohmann::json& used;
-  const std::string& path;
-  template <typename T>
-  T get(const char* key, const T& fallback) const {
-    if (!used.contains(key)) return fallback;
-    try {
-      return used.at(key).get<T>();
-    } catch (const nlohmann::json::exception&) {
-      throw Error("'" + path + "': options." + key + " has the wrong type (" +
-                  used.at(key).type_name() + "); give the result.json of dynid identify unedited");
-    }
-  }
-};
-
-// A result identified with --friction-known stores that friction in options.known_friction: add
-// it back (names, values and layout), so that its predictions are full torques.
-void add_stored_known_friction(const IdentifiedResultFile& f, const std::string& path,
-                               const Model& model, std::vector<std::string>& names,
-                               Eigen::VectorXd& values, IdentifyOptions& options) {
-  const auto it = f.options.find("known_friction");
-  if (it == f.options.end()) return;
-  std::vector<std::string> known_names;
-  std::vector<double> known_values;
-  try {
-    for (const auto& p : *it) {
-      known_names.push_back(p.at("name").get<std::string>());
-      known_values.push_back(p.at("value").get<double>());
-    }
-  } catch (const nlohmann::json::exception&) {
-    throw Error("'" + path +
-                "': options.known_friction must list {name, value}; give the result of "
-                "identify --friction-known unedited");
-  }
-  KnownFriction known;
-  add_known_friction(known, model, known_names,
-                     Eigen::Map<const Eigen::VectorXd>(
-                         known_values.data(), static_cast<Eigen::Index>(known_values.size())),
-                     path);
-  append_known_friction(known, names, values, options.layout);
-}
-
-// A result as a complete model (complete_identified_model): the parameters its data left
-// undetermined or badly determined take the nominal model's values, said on stderr.
-CompletedModel completed_result_model(const Model& model, const IdentifiedResultFile& f,
-                                      const std::string& path,
-                                      const std::vector<std::string>& names,
-                                      const Eigen::VectorXd& values, const IdentifyOptions& options,
-                                      const std::string& command) {
-  CompletedModel c = complete_identified_model(model, names, values, f.std_devs, f.not_excited,
-                                               f.data_regrouping, f.covariance, options);
-  for (const std::string& w : c.warnings) warn(command + ": '" + path + "': " + w);
-  return c;
-}
-
 // The model whose rigid-body and armature torques a friction experiment subtracts: the robot's
 // nominal one, or the one identified in `params` (its base parameters, the rest nominal).
 Model compensation_model(const Model& model, const std::string& params) {
@@ -456,22 +357,9 @@ CompletedModel completed_model_from_result(const Model& model, const std::string
   }
   const IdentifiedResultFile f = read_identification_result(params);
   require_same_robot(f.robot, model.name, "'" + params + "'", "give a result of this robot");
-  IdentifyCliOptions o;
-  const FileOptions file_options{f.options, params};
-  o.friction = file_options.get("friction", o.friction);
-  o.no_armature = !file_options.get("armature", true);
-  IdentifyOptions options = library_options(o);
-  std::vector<std::string> names = f.names;
-  Eigen::VectorXd values = f.values;
-  add_stored_known_friction(f, params, model, names, values, options);
-  return completed_result_model(model, f, params, names, values, options, command);
-}
-
-nlohmann::json parameter_sources_json(const CompletedModel& c) {
-  return {{"identified", c.identified},
-          {"nominal_not_excited", c.nominal_not_excited},
-          {"nominal_badly_determined", c.nominal_badly_determined},
-          {"max_shift_sigma", c.max_shift_sigma}};
+  CompletedModel c = completed_model_of_result(model, f, params);
+  for (const std::string& w : c.warnings) warn(command + ": '" + params + "': " + w);
+  return c;
 }
 
 namespace {
@@ -727,27 +615,6 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   write_report(o.report, o.out, out);
 }
 
-// A usage error raised by an option value read from a result file: the file and its key are at
-// fault, not the command-line flag the message names (exit 1, not 2).
-Error file_option_error(const UsageError& e, const std::string& path) {
-  static const std::pair<const char*, const char*> kKeys[] = {
-      {"--friction", "friction"},
-      {"--filter", "filter"},
-      {"--cutoff", "cutoff_hz"},
-      {"--torque-offset", "torque_offset_s"},
-      {"--zero-velocity", "zero_velocity"}};
-  std::string text = e.what();
-  for (const auto& [flag, key] : kKeys) {
-    if (text.rfind(flag, 0) == 0) {
-      text = "options." + std::string(key) + text.substr(std::string(flag).size());
-      break;
-    }
-  }
-  return Error("'" + path + "': " + text +
-               " (in the file; give the result.json of dynid identify "
-               "unedited)");
-}
-
 struct ValidateCliOptions {
   std::string robot, params, data, json, columns, mode = "torque", trajectory, engine = "mujoco";
   std::string predicted;
@@ -797,12 +664,15 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
   std::vector<std::string> names = identified.names;
   Eigen::VectorXd values = identified.values;
   RunFileReport read;
-  ResultOptionOverrides overrides;
+  StoredOptionOverrides overrides;
   if (cmd.count("--cutoff")) overrides.cutoff = v.cutoff;
   overrides.zero_velocity = v.zero_velocity;
   overrides.torque_scale_given = !v.torque_scale.empty() || cmd.count("--torque-scale");
-  IdentifyOptions options =
-      options_from_identification_result(identified, v.params, model.dof(), overrides, file, read);
+  const StoredIdentifyOptions stored =
+      options_of_stored_result(identified, v.params, model.dof(), overrides);
+  if (!overrides.torque_scale_given) file.torque_scale = stored.torque_scale;
+  read.notes.insert(read.notes.end(), stored.notes.begin(), stored.notes.end());
+  IdentifyOptions options = stored.options;
   add_stored_known_friction(identified, v.params, model, names, values, options);
   const JointRecord record = read_joint_record(v.data, model, file, &read);
   if (v.mode == "simulation") {
@@ -833,8 +703,8 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
                                          : FeedForward::kComputedTorque;
     read.notes.push_back("controller " + controller);
     echo_choices("validate", read, {});
-    const CompletedModel completed =
-        completed_result_model(model, identified, v.params, names, values, options, "validate");
+    const CompletedModel completed = completed_model_of_result(model, identified, v.params);
+    for (const std::string& w : completed.warnings) warn("validate: '" + v.params + "': " + w);
     const SimulationValidation sv =
         validate_run_by_simulation(completed.model, ref.t, ref.q, ref.dq, ref.ddq, record.q,
                                    record.tau, plant, feed_forward, gains);
@@ -857,12 +727,12 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
     result = validate_torques(model, record, names, values, options, identified.not_excited);
   } catch (const UsageError& e) {  // --zero-velocity is the user's own when given
     if (!v.zero_velocity.empty()) throw;
-    throw file_option_error(e, v.params);
+    throw stored_option_error(e, v.params);
   }
   // Closed-loop results are validated on the measured torques: the question is how well the model
   // predicts what the robot measures (docs/methods/projection.md, "Validation").
   const std::string closed =
-      FileOptions{identified.options, v.params}.get("closed_loop", std::string("none"));
+      ResultFileOptions{identified.options, v.params}.get("closed_loop", std::string("none"));
   if (closed != "none")
     result.choices.emplace_back(
         "closed_loop",
@@ -894,54 +764,6 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
 }
 
 }  // namespace
-
-IdentifyOptions options_from_identification_result(const IdentifiedResultFile& identified,
-                                                   const std::string& path, int dof,
-                                                   const ResultOptionOverrides& overrides,
-                                                   RunFileOptions& file, RunFileReport& read) {
-  // The same friction set and signal processing as the identification that wrote the file.
-  IdentifyCliOptions o;
-  const FileOptions file_options{identified.options, path};
-  o.friction = file_options.get("friction", o.friction);
-  o.no_armature = !file_options.get("armature", true);
-  o.filter = file_options.get("filter", o.filter);
-  // The cut-off identify used (its automatic choice included), not one chosen again on this run.
-  if (overrides.cutoff) {
-    o.cutoff = *overrides.cutoff;
-  } else if (identified.cutoff_hz > 0.0) {
-    o.cutoff = identified.cutoff_hz;
-    read.notes.push_back("cut-off as identify used it (stored in '" + path + "')");
-  } else {
-    o.cutoff = file_options.get("cutoff_hz", 0.0);
-  }
-  o.savgol = file_options.get("savitzky_golay", false);
-  o.torque_offset = file_options.get("torque_offset_s", 0.0);
-  o.filter_coulomb = file_options.get("filter_coulomb_columns", false);
-  // The rows left out are those below the thresholds identify used (stored in the result), not
-  // thresholds recomputed from this run.
-  if (!overrides.zero_velocity.empty()) {
-    o.zero_velocity = overrides.zero_velocity;
-  } else if (static_cast<int>(identified.zero_velocity_threshold.size()) == dof) {
-    o.zero_velocity = identified.zero_velocity_threshold;
-    if (*std::max_element(o.zero_velocity.begin(), o.zero_velocity.end()) > 0.0) {
-      read.notes.push_back("zero-velocity thresholds as identify used them (stored in '" + path +
-                           "')");
-    }
-  } else {
-    o.zero_velocity = file_options.get("zero_velocity", std::vector<double>{});
-  }
-  if (!overrides.torque_scale_given) {
-    file.torque_scale = file_options.get("torque_scale", std::vector<double>{});
-    if (!file.torque_scale.empty()) {
-      read.notes.push_back("--torque-scale as given to identify (stored in '" + path + "')");
-    }
-  }
-  try {
-    return library_options(o);
-  } catch (const UsageError& e) {
-    throw file_option_error(e, path);
-  }
-}
 
 void add_identify_command(CLI::App& app) {
   auto o = std::make_shared<IdentifyCliOptions>();

@@ -1,5 +1,5 @@
 // `dynid payload`: a gripped load's inertial parameters from a wrist force/torque sensor (seed 1
-// §III). Parse, validate, call the library (estimation/load_identification.hpp), write JSON.
+// §III). Parse, validate, call the library (load/load_identification.hpp), write JSON.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -15,18 +15,20 @@
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
-#include "dynid/estimation/load_identification.hpp"
+#include "dynid/identification/identify.hpp"
+#include "dynid/identification/validation.hpp"
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/io/csv_writer.hpp"
 #include "dynid/io/joint_columns.hpp"
 #include "dynid/io/joint_record_file.hpp"
 #include "dynid/io/json_writer.hpp"
+#include "dynid/load/load_identification.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/report/html_report.hpp"
 #include "dynid/report/payload_report.hpp"
+#include "dynid/report/stored_result.hpp"
 #include "dynid/version.hpp"
 #include "flag_checks.hpp"
-#include "result_options.hpp"
 
 namespace dynid::cli {
 namespace {
@@ -124,8 +126,11 @@ void run_payload_from_result(const PayloadCliOptions& cli, LoadIdentificationOpt
   require_same_robot(identified.robot, model.name, "--reference '" + cli.reference + "'",
                      "give a result of the robot that carries the load");
   RunFileReport read;
-  const IdentifyOptions identify =
-      options_from_identification_result(identified, cli.reference, model.dof(), {}, file, read);
+  const StoredIdentifyOptions stored =
+      options_of_stored_result(identified, cli.reference, model.dof());
+  file.torque_scale = stored.torque_scale;
+  read.notes.insert(read.notes.end(), stored.notes.begin(), stored.notes.end());
+  const IdentifyOptions& identify = stored.options;
   for (const auto& note : read.notes) std::cerr << "payload: " << one_line(note) << '\n';
   if (cli.cutoff != 0.0 || cli.no_filter) {
     std::cerr << "warning: --cutoff and --no-filter have no effect with a result.json reference: "

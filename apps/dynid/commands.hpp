@@ -1,7 +1,7 @@
 #pragma once
 
 // The dynid subcommands. Each file cmd_<name>.cpp registers one subcommand: parse -> validate ->
-// call the library -> write results. No math here (DESIGN.md section 2).
+// call the library -> write results. No math here (docs/design.md section 2).
 
 #include <string>
 
@@ -9,8 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "dynid/estimation/completed_model.hpp"
 #include "dynid/model/model.hpp"
+#include "dynid/physical/completed_model.hpp"
 
 namespace dynid {
 struct SignalOptions;
@@ -47,11 +47,6 @@ void add_simulate_command(CLI::App& app);
 /// `dynid average`: mean period and noise statistics of a periodic run (cmd_average.cpp).
 void add_average_command(CLI::App& app);
 
-/// Reads `--filter auto|none|butterworth[:ORDER]|chebyshev[:ORDER[:RIPPLE_DB]]` into s.filter,
-/// family, order (Chebyshev default 8, seed 2 §3.4), ripple_db; "auto" leaves s unchanged.
-/// Throws UsageError naming the forms (cmd_identify.cpp; identify and average).
-void parse_filter(const std::string& text, SignalOptions& s);
-
 /// `dynid payload`: a gripped load's parameters from a wrist force/torque sensor (cmd_payload.cpp).
 void add_payload_command(CLI::App& app);
 
@@ -65,10 +60,6 @@ void add_compare_control_command(CLI::App& app);
 /// dynid::Error naming the file (unreadable, another robot, a name that is no base parameter).
 CompletedModel completed_model_from_result(const Model& model, const std::string& params,
                                            const std::string& command);
-
-/// `parameter_sources` of a JSON output: identified, nominal_not_excited,
-/// nominal_badly_determined, max_shift_sigma (CompletedModel).
-nlohmann::json parameter_sources_json(const CompletedModel& completed);
 
 /// `dynid export`: physically consistent parameters written as URDF (cmd_export.cpp).
 void add_export_command(CLI::App& app);

@@ -25,7 +25,7 @@ model = load("model.json")
 truth = {p["name"]: p["value"] for p in model["standard_parameters"]}
 for j, f in enumerate(model["friction"], start=1):
     truth[f"Ia{j}"] = f["Ia"]
-    # Asymmetric form of the plant's friction (DESIGN.md section 3): Fvp = Fvn = Fv,
+    # Asymmetric form of the plant's friction (docs/design.md section 3): Fvp = Fvn = Fv,
     # Fcp = Fc + Fo, Fcn = Fc - Fo.
     truth[f"Fvp{j}"] = truth[f"Fvn{j}"] = f["Fv"]
     truth[f"Fcp{j}"] = f["Fc"] + f.get("Fo", 0.0)

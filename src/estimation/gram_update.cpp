@@ -24,8 +24,8 @@ void gram_update_eigen(Eigen::Index q, Eigen::Index k, const double* B, Eigen::I
 #ifdef DYNID_GRAM_AVX2
 // 8×4 register tiles of G (rows i0…i0+7, columns j0…j0+3) over the upper triangle: per column of
 // B two 4-wide loads, four broadcasts and eight fused multiply-adds. The default build targets
-// plain x86-64 (SSE2, DESIGN.md §1), where Eigen's rank update runs at ≈ 4 flops per cycle; this
-// kernel reaches ≈ 3× that. Only raw pointers cross its boundary, so no Eigen object is built
+// plain x86-64 (SSE2, docs/design.md §1), where Eigen's rank update runs at ≈ 4 flops per cycle;
+// this kernel reaches ≈ 3× that. Only raw pointers cross its boundary, so no Eigen object is built
 // with other vectorisation settings than the rest of the library.
 __attribute__((target("avx2,fma"))) void gram_update_avx2(Eigen::Index q, Eigen::Index k,
                                                           const double* B, Eigen::Index ldb,

@@ -1,4 +1,5 @@
 #include "dynid/report/html_report.hpp"
+#include "dynid/identification/validation.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,9 +8,9 @@
 #include <sstream>
 
 #include "dynid/common/error.hpp"
-#include "dynid/estimation/integral_equations.hpp"
-#include "dynid/estimation/pipeline.hpp"
 #include "dynid/excitation/fourier_trajectory.hpp"
+#include "dynid/identification/integral_equations.hpp"
+#include "dynid/identification/pipeline.hpp"
 #include "dynid/io/atomic_file.hpp"
 #include "dynid/sim/error_statistics.hpp"
 #include "dynid/version.hpp"

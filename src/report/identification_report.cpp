@@ -1,4 +1,5 @@
 #include "dynid/report/identification_report.hpp"
+#include "dynid/identification/validation.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,5 @@
 #include "dynid/workflow/demo.hpp"
+#include "dynid/identification/validation.hpp"
 
 #include <cstdio>
 #include <filesystem>

@@ -11,7 +11,7 @@
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/statistics.hpp"
 #include "dynid/estimation/streaming_least_squares.hpp"
-#include "estimation/estimation_support.hpp"
+#include "support/estimation_support.hpp"
 
 namespace dynid {
 namespace {

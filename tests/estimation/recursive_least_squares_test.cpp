@@ -9,7 +9,7 @@
 
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/recursive_least_squares.hpp"
-#include "estimation/estimation_support.hpp"
+#include "support/estimation_support.hpp"
 
 namespace dynid {
 namespace {

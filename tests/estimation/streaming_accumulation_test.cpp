@@ -10,8 +10,8 @@
 #include <Eigen/QR>
 
 #include "dynid/estimation/streaming_least_squares.hpp"
-#include "estimation/estimation_support.hpp"
 #include "estimation/gram_update.hpp"
+#include "support/estimation_support.hpp"
 
 namespace dynid {
 namespace {

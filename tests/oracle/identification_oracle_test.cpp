@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "dynid/estimation/identification.hpp"
+#include "dynid/identification/identify.hpp"
 #include "dynid/io/urdf_writer.hpp"
 #include "dynid/model/robots.hpp"
 #include "oracle/kdl_bridge.hpp"

@@ -4,9 +4,9 @@
 // tests and bench/dynamics_bench. KDL's API passes Eigen objects (JntArray::data, ...) and
 // Debian's KDL is built for plain x86-64, while the `native` preset builds dynid with
 // -march=native, where Eigen aligns its heap blocks differently: no Eigen object may cross that
-// boundary (DESIGN.md section 1). This header includes neither Eigen nor KDL; its implementation
-// is a shared library compiled without -march=native and with hidden symbols, so its Eigen code
-// is never merged with the native build's (cmake/DynidKdlBridge.cmake).
+// boundary (docs/design.md section 1). This header includes neither Eigen nor KDL; its
+// implementation is a shared library compiled without -march=native and with hidden symbols, so its
+// Eigen code is never merged with the native build's (cmake/DynidKdlBridge.cmake).
 
 #include <memory>
 #include <string>

@@ -1,4 +1,4 @@
-// The exported URDF (io/urdf_export.hpp), loaded by dynid, by KDL and by MuJoCo, predicts the
+// The exported URDF (physical/urdf_export.hpp), loaded by dynid, by KDL and by MuJoCo, predicts the
 // torques of the identified base model Y_b·θ_b (issue 15 item 3).
 #include <cstdio>
 #include <fstream>
@@ -10,10 +10,10 @@
 
 #include "dynid/dynamics/rnea.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
-#include "dynid/io/urdf_export.hpp"
 #include "dynid/io/urdf_writer.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/model/urdf_loader.hpp"
+#include "dynid/physical/urdf_export.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
 #include "oracle/kdl_bridge.hpp"
 #include "oracle/oracle_support.hpp"

@@ -6,8 +6,9 @@
 #include <gtest/gtest.h>
 
 #include "dynid/common/error.hpp"
-#include "dynid/estimation/identification.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
+#include "dynid/identification/identify.hpp"
+#include "dynid/physical/identified_model.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
 #include "dynid/sim/control_comparison.hpp"
 #include "dynid/sim/pid_controller.hpp"

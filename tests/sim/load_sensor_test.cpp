@@ -11,7 +11,7 @@
 
 #include "dynid/common/error.hpp"
 #include "dynid/dynamics/rnea.hpp"
-#include "dynid/estimation/load_identification.hpp"
+#include "dynid/load/load_identification.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/sim/load_sensor.hpp"
 #include "dynid/sim/simulate_reference.hpp"

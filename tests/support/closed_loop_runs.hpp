@@ -8,9 +8,9 @@
 #include <utility>
 #include <vector>
 
-#include "dynid/estimation/identification.hpp"
 #include "dynid/excitation/fourier_trajectory.hpp"
 #include "dynid/excitation/trajectory_samples.hpp"
+#include "dynid/identification/identify.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/sim/simulate_reference.hpp"
 

@@ -11,7 +11,7 @@
 #include <Eigen/Core>
 
 #include "dynid/dynamics/rnea.hpp"
-#include "dynid/estimation/load_identification.hpp"
+#include "dynid/load/load_identification.hpp"
 #include "support/random_models.hpp"
 
 namespace dynid::load_rig {

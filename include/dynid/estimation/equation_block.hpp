@@ -9,9 +9,9 @@ namespace dynid {
 
 /// A block of linear equations y = W·θ over named standard columns: the one data type between the
 /// "equations" stage of the identification pipeline and its "stack" and "estimate" stages
-/// (DESIGN.md §8). An equations builder (differential: one row per joint and sample, seed 1 eq. 5
-/// / seed 2 eq. 9; integral: one row per energy interval, seed 1 eqs. 15–17; load: one row per
-/// wrench component and sample, seed 1 eq. 28) turns one processed run into a block; blocks of
+/// (docs/design.md §8). An equations builder (differential: one row per joint and sample, seed 1
+/// eq. 5 / seed 2 eq. 9; integral: one row per energy interval, seed 1 eqs. 15–17; load: one row
+/// per wrench component and sample, seed 1 eq. 28) turns one processed run into a block; blocks of
 /// several runs are stacked; the estimators see only blocks.
 struct EquationBlock {
   /// rows × columns regressor over the standard columns named in `columns` (for a robot model,

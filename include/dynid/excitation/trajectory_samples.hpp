@@ -6,7 +6,7 @@
 
 namespace dynid {
 
-/// A trajectory sampled on a uniform time grid; row k is sample k (the CSV layout of DESIGN.md
+/// A trajectory sampled on a uniform time grid; row k is sample k (the CSV layout of docs/design.md
 /// section 4: columns t, q1..qn, dq1..dqn, ddq1..ddqn).
 struct TrajectorySamples {
   Eigen::VectorXd t;    ///< m sample times [s], t_k = k / rate

@@ -6,7 +6,7 @@
 
 namespace dynid {
 
-/// Writes a file atomically (DESIGN.md section 4): `write(out)` fills a temporary file
+/// Writes a file atomically (docs/design.md section 4): `write(out)` fills a temporary file
 /// `<path>.tmp.<pid>` in the same directory, which is then flushed and renamed onto `path`. If
 /// `write` throws, or the stream fails, the temporary file is removed and `path` is untouched (an
 /// existing file keeps its old content); the exception propagates.

@@ -4,14 +4,14 @@
 
 #include <nlohmann/json.hpp>
 
-#include "dynid/estimation/closed_loop.hpp"
+#include "dynid/closed_loop/closed_loop.hpp"
 #include "dynid/io/joint_record_file.hpp"
 #include "dynid/model/model.hpp"
 
 namespace dynid {
 
-/// The reference columns of a run file (`qr*`, optional `dqr*`, `ddqr*`, DESIGN.md §4), sample for
-/// sample with `run` as read_joint_record() read it from the same file and options (the same
+/// The reference columns of a run file (`qr*`, optional `dqr*`, `ddqr*`, docs/design.md §4), sample
+/// for sample with `run` as read_joint_record() read it from the same file and options (the same
 /// --columns mapping and --rows/--time window). No `qr*` column gives an empty record (the
 /// closed-loop preparation names the missing columns). Throws dynid::Error naming the file when
 /// the run's samples are not found in it.

@@ -15,7 +15,7 @@ inline constexpr std::size_t kMaxCsvColumns = 65536;                     ///< he
 inline constexpr std::size_t kMaxCsvFileBytes = std::size_t{256} << 20;  ///< read_csv only
 inline constexpr long kMaxCsvRows = 20'000'000;                          ///< read_csv only
 
-/// Reads a whole CSV file (DESIGN.md section 4) into memory.
+/// Reads a whole CSV file (docs/design.md section 4) into memory.
 /// Format: first non-comment, non-blank line is the header (names, optionally double-quoted); then
 /// one row of numbers per line, comma separated; lines whose first non-blank character is `#` are
 /// comments; LF, CRLF or CR-only line ends (the first line end decides); a leading UTF-8 byte-order

@@ -8,8 +8,8 @@
 
 namespace dynid {
 
-/// A numeric CSV file in memory (DESIGN.md section 4): one named column per signal, one row per
-/// sample. data(i, c) is sample i of column columns[c].
+/// A numeric CSV file in memory (docs/design.md section 4): one named column per signal, one row
+/// per sample. data(i, c) is sample i of column columns[c].
 struct CsvTable {
   std::string source;                ///< file the table was read from (for error messages)
   std::vector<std::string> columns;  ///< header names, unique, in file order

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "dynid/estimation/identification.hpp"
+#include "dynid/identification/record.hpp"
 #include "dynid/io/joint_columns.hpp"
 #include "dynid/model/model.hpp"
 
@@ -18,7 +18,7 @@ struct RunWindow {
   bool empty() const { return !first && !last; }
 };
 
-/// How to read a recorded run (DESIGN.md §4).
+/// How to read a recorded run (docs/design.md §4).
 struct RunFileOptions {
   /// Renames applied before lookup (`--columns from=to,...`). When every `from` is a positive
   /// integer the file is read without a header and `from` is a 1-based column position

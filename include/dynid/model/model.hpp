@@ -11,7 +11,7 @@ namespace dynid {
 /// One-DoF joint kinds. Fixed joints never reach a Model: loaders merge them into the parent link.
 enum class JointType { kRevolute, kPrismatic };
 
-/// Number of standard inertial parameters per link (DESIGN.md section 3).
+/// Number of standard inertial parameters per link (docs/design.md section 3).
 inline constexpr int kLinkParams = 10;
 
 /// Largest number of moving joints a model may have (docs/cli.md, "Input size limits"): the dense
@@ -58,7 +58,7 @@ struct Joint {
   JointFriction friction;
 };
 
-/// Motor <-> joint transmission (DESIGN.md section 3): q_motor = N·(q - q_offset), so
+/// Motor <-> joint transmission (docs/design.md section 3): q_motor = N·(q - q_offset), so
 /// q = N⁻¹·q_motor + q_offset, and tau_joint = Nᵀ·tau_motor. N is n×n, identity by default.
 struct Transmission {
   Eigen::MatrixXd N;         ///< n×n, invertible
@@ -87,7 +87,7 @@ struct Model {
   /// fault.
   void finalize();
 
-  /// The standard parameter vector theta (10 per link, DESIGN.md section 3 order), size 10·n.
+  /// The standard parameter vector theta (10 per link, docs/design.md section 3 order), size 10·n.
   Eigen::VectorXd standard_parameters() const;
 
   /// Names `XX1 XY1 ... M1 XX2 ...` matching standard_parameters().

@@ -9,9 +9,9 @@
 
 namespace dynid {
 
-/// Motor-side positions to joint positions (DESIGN.md §3): q = N⁻¹·q_motor + q_offset, row by row.
-/// qm: samples × n [motor rad]; returns samples × n [rad or m]. Throws dynid::Error on a column
-/// count that is not the model's dof.
+/// Motor-side positions to joint positions (docs/design.md §3): q = N⁻¹·q_motor + q_offset, row by
+/// row. qm: samples × n [motor rad]; returns samples × n [rad or m]. Throws dynid::Error on a
+/// column count that is not the model's dof.
 Eigen::MatrixXd joint_positions_from_motor(const Model& model,
                                            const Eigen::Ref<const Eigen::MatrixXd>& qm);
 

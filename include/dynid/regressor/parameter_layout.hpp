@@ -9,8 +9,8 @@
 
 namespace dynid {
 
-/// Which per-joint columns follow the 10·n link parameters (DESIGN.md section 3). For each joint j,
-/// in this order: Iaj, then Fvj Fcj (or Fvpj Fvnj Fcpj Fcnj when asymmetric), then Foj.
+/// Which per-joint columns follow the 10·n link parameters (docs/design.md section 3). For each
+/// joint j, in this order: Iaj, then Fvj Fcj (or Fvpj Fvnj Fcpj Fcnj when asymmetric), then Foj.
 struct ParameterLayout {
   bool armature = false;    ///< Iaj: tau_j += Ia_j·ddq_j
   bool viscous = false;     ///< Fvj: tau_j += Fv_j·dq_j

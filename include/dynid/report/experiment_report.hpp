@@ -4,11 +4,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "dynid/estimation/decoupled_model.hpp"
-#include "dynid/estimation/friction_experiment.hpp"
-#include "dynid/estimation/gravity_experiment.hpp"
-#include "dynid/estimation/physical_parameters.hpp"
+#include "dynid/experiments/decoupled_model.hpp"
+#include "dynid/experiments/friction_experiment.hpp"
+#include "dynid/experiments/gravity_experiment.hpp"
 #include "dynid/model/model.hpp"
+#include "dynid/physical/physical_parameters.hpp"
 
 namespace dynid {
 

@@ -6,7 +6,8 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
-#include "dynid/estimation/identification.hpp"
+#include "dynid/identification/identify.hpp"
+#include "dynid/identification/validation.hpp"
 
 namespace dynid {
 

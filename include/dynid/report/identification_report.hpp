@@ -4,14 +4,15 @@
 
 #include <nlohmann/json.hpp>
 
-#include "dynid/estimation/identification.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
+#include "dynid/identification/identify.hpp"
+#include "dynid/identification/validation.hpp"
 #include "dynid/model/model.hpp"
 #include "dynid/sim/simulation_validation.hpp"
 
 namespace dynid {
 
-/// The result JSON of DESIGN.md §4 / issue 4: model summary, `parameters` (name, value, std,
+/// The result JSON of docs/design.md §4 / issue 4: model summary, `parameters` (name, value, std,
 /// relative_std_percent, ci_low, ci_high, expression), `confidence_level`, `rank`,
 /// `condition_number`, `samples`, `rows`, `residual_rms` and `joint_relative_error` per joint,
 /// `relative_error`, `unidentifiable`, `warnings`, `choices` (every processing decision), `options`

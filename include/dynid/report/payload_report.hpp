@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "dynid/estimation/load_identification.hpp"
+#include "dynid/load/load_identification.hpp"
 
 namespace dynid {
 

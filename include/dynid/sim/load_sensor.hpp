@@ -4,7 +4,7 @@
 
 #include <Eigen/Core>
 
-#include "dynid/estimation/load_identification.hpp"
+#include "dynid/load/load_identification.hpp"
 #include "dynid/model/model.hpp"
 
 namespace dynid {
@@ -14,7 +14,7 @@ namespace dynid {
 struct MountedLoad {
   SensorMount mount;  ///< carrying link and the sensor's pose on it
   /// The load's ten parameters m mcx mcy mcz Ixx Ixy Ixz Iyy Iyz Izz about S's origin in S
-  /// [kg, kg·m, kg·m²] (DESIGN.md §3, the order of `dynid payload`).
+  /// [kg, kg·m, kg·m²] (docs/design.md §3, the order of `dynid payload`).
   Eigen::VectorXd phi = Eigen::VectorXd::Zero(10);
 };
 

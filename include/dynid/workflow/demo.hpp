@@ -3,8 +3,9 @@
 #include <functional>
 #include <string>
 
-#include "dynid/estimation/identification.hpp"
 #include "dynid/excitation/excitation_optimization.hpp"
+#include "dynid/identification/identify.hpp"
+#include "dynid/identification/validation.hpp"
 
 namespace dynid {
 

@@ -1,0 +1,110 @@
+#pragma once
+
+// The run record and its preparation (docs/design.md §8, "prepare"): what every equation builder,
+// experiment, load and closed-loop method stands on, without identify() itself.
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "dynid/model/model.hpp"
+#include "dynid/regressor/parameter_layout.hpp"
+#include "dynid/signal/lowpass_design.hpp"
+
+namespace dynid {
+
+/// A recorded run on the joint side: time, positions, optional derivatives, torques.
+struct JointRecord {
+  Eigen::VectorXd t;    ///< m time stamps [s], strictly increasing
+  Eigen::MatrixXd q;    ///< m × n [rad or m]
+  Eigen::MatrixXd dq;   ///< m × n or empty: derived from q when absent
+  Eigen::MatrixXd ddq;  ///< m × n or empty: derived from dq when absent
+  Eigen::MatrixXd tau;  ///< m × n joint torques [N·m or N]
+};
+
+/// Signal processing before estimation (issue 4; seed 2 §3.4, Gautier's parallel filtering).
+/// Negative / zero "auto" values are replaced by defaults that the result reports back.
+struct SignalOptions {
+  bool filter =
+      true;  ///< zero-phase low-pass of q and tau with the same filter (parallel filtering)
+  LowpassFamily family = LowpassFamily::kButterworth;  ///< filter prototype
+  int order = 4;                                       ///< filter order
+  /// Low-pass cut-off [Hz]; 0 = auto: choose_cutoff() (signal/noise_floor.hpp), 1.5 × the upper
+  /// end of the band where the position spectrum stands 20 dB above its noise floor, in
+  /// [1 Hz, min(20 Hz, rate/10)].
+  double cutoff_hz = 0.0;
+  double ripple_db = 0.5;  ///< Chebyshev I passband ripple
+  int decimate = 0;        ///< keep every k-th sample; 0 = auto: rate/(10·cutoff), ≥ 1
+  int trim = -1;  ///< samples dropped at each end after filtering; −1 = auto: 3·rate/cutoff
+  bool savitzky_golay =
+      false;  ///< differentiate with Savitzky–Golay instead of central differences
+  /// Coulomb friction is undefined near dq = 0: rows of joint j with |dq_j| below the threshold are
+  /// removed. One value = all joints; else n values. Empty = auto: threshold_j =
+  /// max(zero_velocity_fraction·max|dq_j|, zero_velocity_noise_multiple·σ_dq,j) (real joints leave
+  /// the Coulomb law below a physical velocity band; below the noise the sign of dq is unknown),
+  /// and the Coulomb columns are the filtered expected sign (as with filter_coulomb_columns): with
+  /// a low cut-off the filtered torque's smeared Coulomb step otherwise biases Fv high and Fc low
+  /// (docs/methods/estimation.md, "Friction near zero velocity").
+  std::vector<double> zero_velocity;
+  /// Automatic zero-velocity rule: fraction of max|dq_j| of the processed record (the band where
+  /// real joint friction is not Fc·sign(dq): pre-sliding, Stribeck; 1 % matches FIGAROH's TX40).
+  double zero_velocity_fraction = 0.01;
+  /// Automatic zero-velocity rule: multiple k of the processed velocity's noise std σ_dq.
+  double zero_velocity_noise_multiple = 3.0;
+  /// The torque logged at time stamp t acts at t + torque_time_offset [s]; the torques are
+  /// re-interpolated (linearly) onto the position time stamps before filtering. A controller that
+  /// logs the command it then holds for one period (zero-order hold, as `dynid simulate` does)
+  /// needs +T/2: central differences centre q̈ on the sample, the held torque half a period later.
+  /// A torque sensor lagging by d needs −d. 0 = as logged.
+  double torque_time_offset = 0.0;
+  /// Filter the Coulomb columns of the regressor (sign(dq), or [dq>0] and −[dq<0]; with a known
+  /// velocity noise σ_dq the expected sign erf(dq/(√2·σ_dq)) and its halves) with the same
+  /// zero-phase filter as tau, from the full-rate velocity (Gautier's parallel filtering applied to
+  /// the one discontinuous column): the filtered torque's smeared Coulomb step at a velocity
+  /// reversal is then matched by the model instead of biasing Fv and Fc. Only with `filter`;
+  /// coupled-motor Coulomb columns stay unfiltered.
+  bool filter_coulomb_columns = false;
+};
+
+/// Per-joint zero-velocity thresholds [rad/s or m/s] from SignalOptions::zero_velocity: one value
+/// for all n joints, or n values; empty gives an empty vector (the caller's automatic rule).
+/// Throws dynid::UsageError for any other count.
+Eigen::VectorXd given_zero_velocity(const std::vector<double>& zero_velocity, int n);
+
+/// The preprocessed data actually used for estimation (useful for plots and validation).
+struct ProcessedRecord {
+  JointRecord record;    ///< filtered, differentiated, trimmed and decimated
+  double rate_hz = 0.0;  ///< sample rate of `record`
+  /// With SignalOptions::filter_coulomb_columns: [dq_j > 0] and [dq_j < 0] at the full rate,
+  /// filtered like tau, trimmed and decimated like `record` (m × n each); else empty.
+  Eigen::MatrixXd moving_positive, moving_negative;
+  double cutoff_hz = 0.0;  ///< low-pass cut-off used [Hz]; 0 without filter
+  int trim = 0;            ///< samples dropped at each end after filtering (resolved)
+  int decimate = 1;        ///< every decimate-th sample kept (resolved)
+  /// Per joint, std of the white position noise floor of the input (position_noise_floor) and of
+  /// the resulting noise on the processed velocity [rad/s or m/s]; 0 when not measurable.
+  Eigen::VectorXd position_noise_std, velocity_noise_std;
+};
+
+/// Sample-major regressor of a processed record (stacked_regressor), with the Coulomb columns
+/// replaced by their filtered versions when the record carries them (filter_coulomb_columns).
+Eigen::MatrixXd processed_regressor(const Model& model, const ParameterLayout& layout,
+                                    bool coupling, const ProcessedRecord& processed);
+
+/// Sample-major stacked regressor of the layout plus coupling columns for a record:
+/// rows k·n … k·n+n−1 are sample k. Size (m·n) × (layout.columns(n) + coupling_columns(model)).
+Eigen::MatrixXd stacked_regressor(const Model& model, const ParameterLayout& layout, bool coupling,
+                                  const JointRecord& record);
+
+/// Names of the columns of stacked_regressor.
+std::vector<std::string> stacked_regressor_names(const Model& model, const ParameterLayout& layout,
+                                                 bool coupling);
+
+/// Filters, differentiates, trims and decimates a record as SignalOptions says; fills in the auto
+/// choices (written to `choices`). Throws dynid::Error for too few samples or bad time stamps.
+ProcessedRecord preprocess(const JointRecord& record, const SignalOptions& options,
+                           std::vector<std::pair<std::string, std::string>>& choices);
+
+}  // namespace dynid

@@ -1,0 +1,100 @@
+#pragma once
+
+// A stored identification result applied again (issue 24 item 2): identify's options rebuilt from
+// the result JSON's `options` and `choices`, the result's known friction added back, and the
+// complete model of a result. The command line (validate, payload --reference, simulate --params,
+// compare-control, identify --params) and the Python module call these, so both read a result the
+// same way.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "dynid/common/error.hpp"
+#include "dynid/identification/identify.hpp"
+#include "dynid/identification/option_text.hpp"
+#include "dynid/identification/record.hpp"
+#include "dynid/model/model.hpp"
+#include "dynid/physical/completed_model.hpp"
+#include "dynid/regressor/parameter_layout.hpp"
+#include "dynid/report/identification_report.hpp"
+
+namespace dynid {
+
+/// The `options` object a result JSON records, read with the file and key named in every error
+/// (a wrong type is the file's fault, not a command-line flag's).
+struct ResultFileOptions {
+  const nlohmann::json& used;  ///< IdentifiedResultFile::options
+  const std::string& path;     ///< the file (or "result"), named in errors
+  /// options[key] as T; `fallback` when the key is absent. Throws dynid::Error naming the file and
+  /// the key for a value of another type.
+  template <typename T>
+  T get(const char* key, const T& fallback) const {
+    if (!used.contains(key)) return fallback;
+    try {
+      return used.at(key).get<T>();
+    } catch (const nlohmann::json::exception&) {
+      throw Error("'" + path + "': options." + key + " has the wrong type (" +
+                  used.at(key).type_name() + "); give the result.json of dynid identify unedited");
+    }
+  }
+};
+
+/// A usage error raised by an option value read from result `path`: the same text with the flag
+/// (--friction, --filter, --cutoff, --torque-offset, --zero-velocity) replaced by its key
+/// (options.friction, ...), as a dynid::Error (the file is at fault, exit 1, not 2).
+Error stored_option_error(const UsageError& e, const std::string& path);
+
+/// What the caller sets instead of the stored result (validate's --cutoff, --zero-velocity,
+/// --torque-scale).
+struct StoredOptionOverrides {
+  std::optional<double> cutoff;       ///< low-pass cut-off [Hz]; unset: the one identify used
+  std::vector<double> zero_velocity;  ///< per joint [rad/s]; empty: the thresholds identify used
+  bool torque_scale_given = false;    ///< true: the caller's torque scale, not the stored one
+};
+
+/// identify's options as a stored result rebuilds them (StoredIdentifyOptions).
+struct StoredIdentifyOptions {
+  /// The friction set and armature, filter, the cut-off identify used (choices.cutoff_hz, its
+  /// automatic choice included), Savitzky–Golay, torque offset, filtered Coulomb columns and the
+  /// zero-velocity thresholds identify used; everything else at identify's defaults.
+  IdentifyOptions options;
+  /// options.torque_scale as given to identify (empty when none, or when
+  /// StoredOptionOverrides::torque_scale_given).
+  std::vector<double> torque_scale;
+  std::vector<std::string> notes;  ///< one line per value taken from the file
+};
+
+/// Rebuilds identify's regressor and signal processing from `identified` (read from `path`) for a
+/// run of a `dof`-joint robot, so that a prediction on another run compares the same kind of rows
+/// as the fit. The friction set is options.friction (text) or, in a Python result,
+/// options.viscous/coulomb/offset/asymmetric (booleans); options.filter is text or a boolean.
+/// Throws dynid::Error naming `path` and the key for a value of the wrong type or an invalid
+/// option in the file.
+StoredIdentifyOptions options_of_stored_result(const IdentifiedResultFile& identified,
+                                               const std::string& path, int dof,
+                                               const StoredOptionOverrides& overrides = {});
+
+/// A result identified with --friction-known stores that friction in options.known_friction: adds
+/// it back to `names`/`values` and `options.layout` (append_known_friction), so that its
+/// predictions are full torques. No change without it. Throws dynid::Error naming `path` for a
+/// malformed list.
+void add_stored_known_friction(const IdentifiedResultFile& identified, const std::string& path,
+                               const Model& model, std::vector<std::string>& names,
+                               Eigen::VectorXd& values, IdentifyOptions& options);
+
+/// The complete model of a stored result (complete_identified_model()): its base parameters with
+/// its friction set, armature and known friction, the parameters its data left undetermined or
+/// badly determined at the nominal model's values, said in CompletedModel::warnings. Throws
+/// dynid::Error naming `path` (an invalid option, a name that is no base parameter).
+CompletedModel completed_model_of_result(const Model& model, const IdentifiedResultFile& identified,
+                                         const std::string& path);
+
+/// `parameter_sources` of a JSON output: identified, nominal_not_excited,
+/// nominal_badly_determined, max_shift_sigma (CompletedModel).
+nlohmann::json parameter_sources_json(const CompletedModel& completed);
+
+}  // namespace dynid

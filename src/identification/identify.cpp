@@ -1,0 +1,293 @@
+#include "dynid/identification/identify.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include <Eigen/SVD>
+
+#include "dynid/closed_loop/closed_loop.hpp"
+#include "dynid/closed_loop/maximum_likelihood.hpp"
+#include "dynid/common/error.hpp"
+#include "dynid/estimation/least_squares.hpp"
+#include "dynid/estimation/recursive_least_squares.hpp"
+#include "dynid/estimation/statistics.hpp"
+#include "dynid/identification/cutoff_selection.hpp"
+#include "dynid/identification/integral_equations.hpp"
+#include "dynid/identification/outliers.hpp"
+#include "dynid/identification/pipeline.hpp"
+#include "dynid/model/transmission.hpp"
+#include "identification/preparation.hpp"
+
+namespace dynid {
+
+namespace {
+
+// The joint a layout column belongs to: link parameters of link j and joint columns of joint j;
+// −1 for coupled-motor columns.
+int column_joint(const Model& model, const ParameterLayout& layout, int column) {
+  const int n = model.dof();
+  if (column < kLinkParams * n) return column / kLinkParams;
+  const int jc = layout.joint_columns();
+  if (jc > 0 && column < kLinkParams * n + jc * n) return (column - kLinkParams * n) / jc;
+  return -1;
+}
+
+// it where that is cheap to say (its own joint, or the parameters it cannot be told from).
+void not_excited_warnings(const Model& model, const ParameterLayout& layout,
+                          const BaseParameters& base, const EquationBlock& based,
+                          const DataIdentifiability& data, std::vector<std::string>& warnings) {
+  std::ostringstream head;
+  head << "the data excite " << data.rank << " of the model's " << base.rank
+       << " base parameters (data rank; column-scaled singular values below " << data.tolerance
+       << " x the largest count as zero): the others are not estimated (not_excited)";
+  warnings.push_back(head.str());
+  for (int c : data.not_excited) {
+    const std::string& name = base.names[static_cast<size_t>(c)];
+    const int joint = column_joint(model, layout, base.base[static_cast<size_t>(c)]);
+    std::ostringstream w;
+    w << name << " is not excited: ";
+    if (based.W.col(c).squaredNorm() == 0.0) {
+      w << "its column is zero on every equation used";
+    } else {
+      std::string with;
+      for (size_t i = 0; i < data.kept.size(); ++i) {
+        for (const auto& [col, coef] : data.absorbs[i]) {
+          if (col == c)
+            with += (with.empty() ? "" : ", ") + base.names[static_cast<size_t>(data.kept[i])];
+        }
+      }
+      w << "the data cannot tell it from " << (with.empty() ? "the other parameters" : with)
+        << " (those estimates include its effect on these runs)";
+    }
+    if (joint >= 0) {
+      w << "; a run in which " << model.joints[static_cast<size_t>(joint)].name
+        << " moves (above its encoder noise, with both velocity signs and varied "
+           "configurations of the joints before it) would excite it";
+    }
+    warnings.push_back(w.str());
+  }
+}
+
+}  // namespace
+
+IdentificationResult identify(const Model& model, const JointRecord& record,
+                              const IdentifyOptions& options) {
+  return identify(model, std::vector<JointRecord>{record}, options);
+}
+
+IdentificationResult identify(const Model& model, const std::vector<JointRecord>& runs,
+                              const IdentifyOptions& options) {
+  return identify(model, runs, {}, options);
+}
+
+IdentificationResult identify(const Model& model, const std::vector<JointRecord>& runs,
+                              const std::vector<ReferenceRecord>& references,
+                              const IdentifyOptions& options) {
+  if (runs.empty()) throw Error("identify: no run given; pass at least one recorded run");
+  const int n = model.dof();
+  IdentificationResult result;
+  const bool coupling = options.coupling && !coupled_motors(model).empty();
+  const bool integral = options.model == IdentificationModel::kIntegral;
+  if (integral && !options.known_friction.empty())
+    throw UsageError("known friction is subtracted from joint torques: use the differential model");
+  const bool closed = options.closed_loop.method != ClosedLoopMethod::kNone;
+  const bool ml = options.estimator == IdentificationEstimator::kMl;
+  check_closed_loop_request(options, runs.size(), references.size());
+  Eigen::Index projected_dimensions = 0;  // Σ over runs and joints of the projector's rank
+  std::vector<ProcessedRecord> prepared;  // every run's (maximum likelihood needs them all)
+  ProjectedRun projected;                 // the first run's projection (maximum likelihood)
+  if (integral) {
+    std::ostringstream m;
+    m << "integral (energy) model, "
+      << (options.integral.long_integrals ? "long integrals from the first sample in steps of "
+                                          : "short intervals of ")
+      << options.integral.interval << " s";
+    result.choices.emplace_back("model", m.str());
+  } else {
+    result.choices.emplace_back("model", "differential (joint torques)");
+  }
+  // prepare + equations, one run at a time (each its own rate, filter edges, derivatives).
+  std::vector<EquationBlock> blocks;
+  std::vector<ScreenedRun> screened;
+  result.zero_velocity_threshold = Eigen::VectorXd::Zero(n);
+  for (size_t i = 0; i < runs.size(); ++i) {
+    std::vector<std::pair<std::string, std::string>> choices;
+    screened.push_back(screen_run(model, runs[i], options.outliers));  // outliers.hpp
+    ProcessedRecord processed;
+    Eigen::VectorXd threshold = Eigen::VectorXd::Zero(n);
+    if (closed) {
+      ClosedLoopIdOptions co = options.closed_loop;
+      co.torque_time_offset = options.signal.torque_time_offset;
+      ClosedLoopRun cl = prepare_closed_loop(screened.back().record, references[i], co, choices);
+      processed = std::move(cl.processed);
+      // Known friction (seed 2 section 3.4) leaves the torque before the projection, so that
+      // both sides of the regression are projected alike.
+      EquationBlock raw =
+          differential_equations(model, options.layout, coupling, processed, Eigen::VectorXd());
+      subtract_known_friction(model, options.known_friction, processed, raw);
+      blocks.push_back(project_equations(raw, *cl.projector));
+      projected_dimensions += static_cast<Eigen::Index>(n) * cl.report.rank;
+      if (i == 0) {
+        projected.projector = cl.projector;
+        projected.torque_remainder_std = cl.torque_remainder_std;
+      }
+      result.closed_loop.push_back(std::move(cl.report));
+    } else if (integral) {
+      // The held-out cut-off selection fits the differential model; the integral model has its
+      // own fixed defaults (integral_signal_options()).
+      SignalOptions signal = options.signal;
+      if (signal.cutoff_hz <= 0.0) signal.cutoff_hz = integral_signal_options().cutoff_hz;
+      if (signal.decimate <= 0) signal.decimate = 1;
+      processed = preprocess_run(model, screened.back().record, signal, choices);
+      hold_still_joints(model, processed, choices);
+      blocks.push_back(
+          integral_equations(model, options.layout, coupling, processed, options.integral));
+    } else {
+      // The cut-off of each run from its own data (held-out prediction, cutoff_selection.hpp).
+      const CutoffSelection cutoff = select_cutoff(model, screened.back().record, options);
+      processed = preprocess_run(model, screened.back().record, cutoff.signal, choices);
+      echo_cutoff_selection(cutoff, choices);
+      hold_still_joints(model, processed, choices);
+      threshold =
+          zero_velocity_threshold(options.layout, options.signal, processed, "removed", choices);
+      blocks.push_back(
+          differential_equations(model, options.layout, coupling, processed, threshold));
+      subtract_known_friction(model, options.known_friction, processed, blocks.back());
+    }
+    RunSummary run;
+    run.samples = processed.record.t.size();
+    run.rows = blocks.back().y.size();
+    run.zero_velocity_threshold = threshold;
+    result.runs.push_back(run);
+    result.samples += run.samples;
+    // Validation leaves out the rows below the largest threshold any run used.
+    result.zero_velocity_threshold = result.zero_velocity_threshold.cwiseMax(threshold);
+    const std::string prefix = runs.size() > 1 ? "run " + std::to_string(i + 1) + " " : "";
+    for (auto& [key, value] : choices) result.choices.emplace_back(prefix + key, value);
+    if (ml) prepared.push_back(processed);
+    if (i == 0) result.processed = std::move(processed);
+    result.warnings.insert(result.warnings.end(), screened.back().warnings.begin(),
+                           screened.back().warnings.end());
+  }
+  // stack + structural base columns (Gautier–Khalil, from the model).
+  BaseParameterOptions base_options = options.base;
+  base_options.layout = options.layout;
+  base_options.coupling = coupling;
+  result.base = compute_base_parameters(model, base_options);
+  result.unidentifiable = result.base.unidentifiable_names();
+  result.rank = result.base.rank;
+  EquationBlock based = select_base_columns(stack_equations(blocks), result.base);
+  result.rows = based.y.size();
+  // Data-identifiable columns: what these data determine of the base set.
+  const DataIdentifiability data = data_identifiability(based);
+  result.data_rank = data.rank;
+  if (result.rows <= data.rank) {
+    throw Error("only " + std::to_string(result.rows) + " equations remain for " +
+                std::to_string(data.rank) +
+                " base parameters; record a longer or faster run, or lower --zero-velocity");
+  }
+  if (data.rank == 0) {
+    throw Error(
+        "the data excite no parameter (no joint moves above its noise); record a run "
+        "in which the joints move");
+  }
+  const bool deficient = !data.not_excited.empty();
+  const EquationBlock W = deficient ? select_columns(based, data.kept) : based;
+  for (int c : data.kept) {
+    result.names.push_back(result.base.names[static_cast<size_t>(c)]);
+    result.expressions.push_back(result.base.expressions[static_cast<size_t>(c)]);
+  }
+  for (int c : data.not_excited) {
+    result.not_excited.push_back(result.base.names[static_cast<size_t>(c)]);
+  }
+  result.data_regrouping =
+      Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(data.kept.size()),
+                            static_cast<Eigen::Index>(data.not_excited.size()));
+  for (size_t i = 0; i < data.kept.size(); ++i) {
+    for (const auto& [col, coef] : data.absorbs[i]) {
+      const auto at = std::find(data.not_excited.begin(), data.not_excited.end(), col);
+      result.data_regrouping(static_cast<Eigen::Index>(i), at - data.not_excited.begin()) = coef;
+      std::ostringstream term;
+      term << std::setprecision(6) << (coef < 0 ? " - " : " + ") << std::abs(coef) << '*'
+           << result.base.names[static_cast<size_t>(col)] << " (on these data)";
+      result.expressions[i] += term.str();
+    }
+  }
+  if (deficient)
+    not_excited_warnings(model, options.layout, result.base, based, data, result.warnings);
+  // estimate
+  BlockEstimationOptions eo;
+  eo.estimator = options.estimator;
+  eo.confidence_level = options.confidence_level;
+  eo.hac_bandwidth = options.hac_bandwidth;
+  eo.record_history = options.record_history;
+  BlockEstimate fit = estimate_block(W, eo);
+  if (blocks.size() > 1 && fit.hac.bandwidth > 0 && !closed) {
+    // Restack with runs a window apart and that window fixed, so that the HAC sums never pair two
+    // runs' errors (the estimate itself does not depend on the spacing).
+    eo.hac_bandwidth = fit.hac.bandwidth;
+    EquationBlock spaced = based;
+    spaced.sample =
+        select_base_columns(stack_equations(blocks, fit.hac.bandwidth + 1), result.base).sample;
+    if (deficient) spaced = select_columns(spaced, data.kept);
+    fit = estimate_block(spaced, eo);
+    fit.covariance_choice += "; runs stacked a window apart (no window spans two runs)";
+  }
+  if (closed) {
+    EstimationOptions so;
+    so.confidence_level = options.confidence_level;
+    so.names = W.columns;
+    // Channel of each row: run × joint, the projected series the clustered sandwich sums over.
+    Eigen::VectorXi channel(W.y.size());
+    Eigen::Index at = 0;
+    for (size_t b = 0; b < blocks.size(); ++b) {
+      const Eigen::Index rows = blocks[b].y.size();
+      channel.segment(at, rows) = W.group.segment(at, rows).array() + static_cast<int>(b) * n;
+      at += rows;
+    }
+    fit.covariance_choice =
+        projected_statistics(fit.estimate, W, projected_dimensions,
+                             options.estimator == IdentificationEstimator::kWls, so, channel);
+  }
+  if (ml) {
+    projected.dimensions = projected_dimensions;
+    std::vector<int> columns;
+    for (int c : data.kept) columns.push_back(result.base.base[static_cast<size_t>(c)]);
+    maximum_likelihood_stage(model, options, coupling, blocks, prepared, screened.front().record,
+                             columns, W, projected, fit, result.choices);
+  }
+  check_finite_estimate(fit.estimate, screened.front());
+  result.estimate = std::move(fit.estimate);
+  result.residual_rms = fit.group_rms;
+  result.joint_relative_error = fit.group_relative_error;
+  result.relative_error = fit.relative_error;
+  result.residual_autocorrelation = fit.group_autocorrelation;
+  result.choices.emplace_back("covariance", fit.covariance_choice);
+  result.history_t = std::move(fit.history_t);
+  result.history_x = std::move(fit.history_x);
+  result.history_std = std::move(fit.history_std);
+  if (options.estimator == IdentificationEstimator::kRls) {
+    result.excitation = persistent_excitation(W, options.excitation_window);
+    result.has_excitation = true;
+  }
+  // Per run: the relative error of its own rows.
+  Eigen::Index at = 0;
+  for (auto& run : result.runs) {
+    const auto e = fit.residual.segment(at, run.rows);
+    const auto y = W.y.segment(at, run.rows);
+    run.relative_error = e.norm() / std::max(y.norm(), 1e-300);
+    at += run.rows;
+  }
+  result.condition_number = result.estimate.summary.condition_number;
+  if (!(result.condition_number > 0.0)) {
+    const Eigen::VectorXd s = Eigen::BDCSVD<Eigen::MatrixXd>(W.W).singularValues();
+    result.condition_number = s[s.size() - 1] > 0.0 ? s[0] / s[s.size() - 1] : INFINITY;
+  }
+  result.warnings.insert(result.warnings.end(), result.estimate.summary.warnings.begin(),
+                         result.estimate.summary.warnings.end());
+  return result;
+}
+
+}  // namespace dynid

@@ -1,0 +1,155 @@
+#include "dynid/report/stored_result.hpp"
+
+#include <algorithm>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "dynid/common/error.hpp"
+#include "dynid/identification/known_friction.hpp"
+
+namespace dynid {
+
+namespace {
+
+// The friction set of a stored result: the command line's text options.friction, or the booleans a
+// Python result records (dynid.identify's armature, viscous, coulomb, offset, asymmetric keywords).
+ParameterLayout stored_layout(const ResultFileOptions& file) {
+  const bool armature = file.get("armature", true);
+  if (!file.used.contains("friction")) {
+    const bool asymmetric = file.get("asymmetric", false);
+    if (file.used.contains("viscous") || file.used.contains("coulomb") ||
+        file.used.contains("offset") || file.used.contains("asymmetric")) {
+      ParameterLayout layout;
+      layout.armature = armature;
+      layout.viscous = file.get("viscous", true) || asymmetric;
+      layout.coulomb = file.get("coulomb", true) || asymmetric;
+      layout.offset = file.get("offset", true);
+      layout.asymmetric = asymmetric;
+      return layout;
+    }
+  }
+  return friction_layout(file.get("friction", std::string("viscous,coulomb,offset")), armature);
+}
+
+}  // namespace
+
+Error stored_option_error(const UsageError& e, const std::string& path) {
+  static const std::pair<const char*, const char*> kKeys[] = {
+      {"--friction", "friction"},
+      {"--filter", "filter"},
+      {"--cutoff", "cutoff_hz"},
+      {"--torque-offset", "torque_offset_s"},
+      {"--zero-velocity", "zero_velocity"}};
+  std::string text = e.what();
+  for (const auto& [flag, key] : kKeys) {
+    if (text.rfind(flag, 0) == 0) {
+      text = "options." + std::string(key) + text.substr(std::string(flag).size());
+      break;
+    }
+  }
+  return Error("'" + path + "': " + text +
+               " (in the file; give the result.json of dynid identify "
+               "unedited)");
+}
+
+StoredIdentifyOptions options_of_stored_result(const IdentifiedResultFile& identified,
+                                               const std::string& path, int dof,
+                                               const StoredOptionOverrides& overrides) {
+  // The same friction set and signal processing as the identification that wrote the file.
+  const ResultFileOptions file{identified.options, path};
+  StoredIdentifyOptions out;
+  IdentifyOptions& o = out.options;
+  try {
+    o.layout = stored_layout(file);
+    if (identified.options.contains("filter") && identified.options["filter"].is_boolean()) {
+      o.signal.filter = identified.options["filter"].get<bool>();  // a Python result
+    } else {
+      apply_filter_text(file.get("filter", std::string("auto")), o.signal);
+    }
+    // The cut-off identify used (its automatic choice included), not one chosen again on this run.
+    if (overrides.cutoff) {
+      o.signal.cutoff_hz = *overrides.cutoff;
+    } else if (identified.cutoff_hz > 0.0) {
+      o.signal.cutoff_hz = identified.cutoff_hz;
+      out.notes.push_back("cut-off as identify used it (stored in '" + path + "')");
+    } else {
+      o.signal.cutoff_hz = file.get("cutoff_hz", 0.0);
+    }
+    o.signal.savitzky_golay = file.get("savitzky_golay", false);
+    o.signal.torque_time_offset = file.get("torque_offset_s", 0.0);
+    o.signal.filter_coulomb_columns = file.get("filter_coulomb_columns", false);
+    // The rows left out are those below the thresholds identify used (stored in the result), not
+    // thresholds recomputed from this run.
+    if (!overrides.zero_velocity.empty()) {
+      o.signal.zero_velocity = overrides.zero_velocity;
+    } else if (static_cast<int>(identified.zero_velocity_threshold.size()) == dof) {
+      o.signal.zero_velocity = identified.zero_velocity_threshold;
+      if (*std::max_element(o.signal.zero_velocity.begin(), o.signal.zero_velocity.end()) > 0.0) {
+        out.notes.push_back("zero-velocity thresholds as identify used them (stored in '" + path +
+                            "')");
+      }
+    } else {
+      o.signal.zero_velocity = file.get("zero_velocity", std::vector<double>{});
+    }
+  } catch (const UsageError& e) {
+    throw stored_option_error(e, path);
+  }
+  if (!overrides.torque_scale_given) {
+    out.torque_scale = file.get("torque_scale", std::vector<double>{});
+    if (!out.torque_scale.empty()) {
+      out.notes.push_back("--torque-scale as given to identify (stored in '" + path + "')");
+    }
+  }
+  return out;
+}
+
+void add_stored_known_friction(const IdentifiedResultFile& identified, const std::string& path,
+                               const Model& model, std::vector<std::string>& names,
+                               Eigen::VectorXd& values, IdentifyOptions& options) {
+  const auto it = identified.options.find("known_friction");
+  if (it == identified.options.end()) return;
+  std::vector<std::string> known_names;
+  std::vector<double> known_values;
+  try {
+    for (const auto& p : *it) {
+      known_names.push_back(p.at("name").get<std::string>());
+      known_values.push_back(p.at("value").get<double>());
+    }
+  } catch (const nlohmann::json::exception&) {
+    throw Error("'" + path +
+                "': options.known_friction must list {name, value}; give the result of "
+                "identify --friction-known unedited");
+  }
+  KnownFriction known;
+  add_known_friction(known, model, known_names,
+                     Eigen::Map<const Eigen::VectorXd>(
+                         known_values.data(), static_cast<Eigen::Index>(known_values.size())),
+                     path);
+  append_known_friction(known, names, values, options.layout);
+}
+
+CompletedModel completed_model_of_result(const Model& model, const IdentifiedResultFile& identified,
+                                         const std::string& path) {
+  IdentifyOptions options;
+  try {
+    options.layout = stored_layout(ResultFileOptions{identified.options, path});
+  } catch (const UsageError& e) {
+    throw stored_option_error(e, path);
+  }
+  std::vector<std::string> names = identified.names;
+  Eigen::VectorXd values = identified.values;
+  add_stored_known_friction(identified, path, model, names, values, options);
+  return complete_identified_model(model, names, values, identified.std_devs,
+                                   identified.not_excited, identified.data_regrouping,
+                                   identified.covariance, options);
+}
+
+nlohmann::json parameter_sources_json(const CompletedModel& c) {
+  return {{"identified", c.identified},
+          {"nominal_not_excited", c.nominal_not_excited},
+          {"nominal_badly_determined", c.nominal_badly_determined},
+          {"max_shift_sigma", c.max_shift_sigma}};
+}
+
+}  // namespace dynid
