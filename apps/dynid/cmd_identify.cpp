@@ -17,8 +17,9 @@
 #include "dynid/experiments/decoupled_model.hpp"
 #include "dynid/experiments/friction_experiment.hpp"
 #include "dynid/experiments/gravity_experiment.hpp"
-#include "dynid/identification/streaming_identification.hpp"
 #include "dynid/identification/identify.hpp"
+#include "dynid/identification/option_text.hpp"
+#include "dynid/identification/streaming_identification.hpp"
 #include "dynid/identification/validation.hpp"
 #include "dynid/io/closed_loop_file.hpp"
 #include "dynid/io/joint_record_file.hpp"
@@ -148,14 +149,6 @@ void warn(const std::string& text) {
   std::cerr << "warning: " << one_line(text) << '\n';
 }
 
-std::vector<std::string> split(const std::string& text, char sep) {
-  std::vector<std::string> out;
-  std::stringstream s(text);
-  std::string item;
-  while (std::getline(s, item, sep)) out.push_back(item);
-  return out;
-}
-
 }  // namespace
 
 namespace {
@@ -199,19 +192,7 @@ IdentifyOptions library_options(const IdentifyCliOptions& o) {
   if (!o.fir.empty()) {
     if (o.closed_loop != "projection")
       throw UsageError("--fir sets the projection's FIR orders: it needs --closed-loop projection");
-    const auto parts = split(o.fir, ',');
-    try {
-      size_t a = 0, b = 0;
-      if (parts.size() != 2) throw UsageError("");
-      out.closed_loop.projection.m1 = std::stoi(parts[0], &a);
-      out.closed_loop.projection.m2 = std::stoi(parts[1], &b);
-      if (a != parts[0].size() || b != parts[1].size() || out.closed_loop.projection.m1 < 0 ||
-          out.closed_loop.projection.m2 < 0)
-        throw UsageError("");
-    } catch (const std::exception&) {
-      throw UsageError("--fir '" + o.fir +
-                       "' is not M1,M2 (two integers >= 0: future and past reference lags)");
-    }
+    apply_fir_text(o.fir, out.closed_loop.projection);
   }
   if (o.period != 0.0 || o.f0 != 0.0) {
     if (o.closed_loop != "spectral")
@@ -730,7 +711,7 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
     throw stored_option_error(e, v.params);
   }
   // Closed-loop results are validated on the measured torques: the question is how well the model
-  // predicts what the robot measures (docs/methods/projection.md, "Validation").
+  // predicts what the robot measures (docs/methods/closed_loop.md, "Validation").
   const std::string closed =
       ResultFileOptions{identified.options, v.params}.get("closed_loop", std::string("none"));
   if (closed != "none")

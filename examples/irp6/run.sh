@@ -18,7 +18,7 @@
 # values (26 N m s and 28.75 N m on every joint: seed 1's joint-2 estimates, examples/robots/irp6.yaml)
 # and the parameters the data do not excite.
 # Seed 1 found long integrals significantly worse than short ones; here that happens only with the
-# unmodelled offset (docs/methods/estimation.md, section 7, "Short against long integrals").
+# unmodelled offset (docs/methods/identification.md, section 4, "Short against long integrals").
 # Usage: examples/irp6/run.sh [OUT_DIR]   (default irp6-out; DYNID=path/to/dynid to override)
 set -euo pipefail
 if [ $# -gt 1 ]; then

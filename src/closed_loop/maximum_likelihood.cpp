@@ -98,7 +98,7 @@ struct SampleRows {
 };
 
 // Whitened residual L⁻¹·b of one sample, S = L·Lᵀ = J·diag(var_x)·Jᵀ + diag(var_tau) (seed 2
-// eqs. 15–16), and its analytic Jacobian (docs/methods/maximum_likelihood.md, "Jacobian"):
+// eqs. 15–16), and its analytic Jacobian (docs/methods/closed_loop.md, "Jacobian"):
 // ∂(L⁻¹b)/∂θ_k = −L⁻¹W_k − Φ(L⁻¹·∂S/∂θ_k·L⁻ᵀ)·L⁻¹b, ∂S/∂θ_k = D_k·Aᵀ + A·D_kᵀ, A = J·diag(var_x),
 // D_k = ∂J/∂θ_k (row a: column k of row a's sensitivity), Φ = lower triangle with half the
 // diagonal (the derivative of a Cholesky factor). J is linear in θ, so this is exact.

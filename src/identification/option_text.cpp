@@ -64,4 +64,19 @@ void apply_filter_text(const std::string& text, SignalOptions& s) {
   }
 }
 
+void apply_fir_text(const std::string& text, ProjectionOptions& projection) {
+  const auto parts = split(text, ',');
+  try {
+    size_t a = 0, b = 0;
+    if (parts.size() != 2) throw UsageError("");
+    projection.m1 = std::stoi(parts[0], &a);
+    projection.m2 = std::stoi(parts[1], &b);
+    if (a != parts[0].size() || b != parts[1].size() || projection.m1 < 0 || projection.m2 < 0)
+      throw UsageError("");
+  } catch (const std::exception&) {
+    throw UsageError("--fir '" + text +
+                     "' is not M1,M2 (two integers >= 0: future and past reference lags)");
+  }
+}
+
 }  // namespace dynid

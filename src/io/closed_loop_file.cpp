@@ -57,7 +57,7 @@ SensorNoise read_sensor_noise(const std::string& path, const Model& model, const
                 "' has no channels list; give the file of dynid average "
                 "--json");
   // The mean period's noise is the raw one over √(periods·decimate): fitting the mean with the
-  // raw std misstates the variance factor by that ratio (docs/methods/maximum_likelihood.md).
+  // raw std misstates the variance factor by that ratio (docs/methods/closed_loop.md).
   auto same_file = [](const nlohmann::json& name, const std::string& other) {
     std::error_code ec;
     return !other.empty() && name.is_string() &&

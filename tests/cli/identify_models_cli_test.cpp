@@ -145,7 +145,7 @@ TEST(IdentifyModelsCli, FrictionAndDecoupledModelsRunAndNameTheirParameters) {
 // The wiring of --model integral: same base parameters and names as the differential model, and a
 // result validate accepts. Whether the two models agree is the library's test
 // (tests/identification/integral_equations_test.cpp); on this short optimised run they do not (6 of
-// 13 apart by more than the sum of their half-widths; docs/methods/estimation.md §7).
+// 13 apart by more than the sum of their half-widths; docs/methods/identification.md §4).
 TEST(IdentifyModelsCli, IntegralModelUsesTheDifferentialBaseParameters) {
   const std::string data =
       simulated("fourier",

@@ -123,7 +123,7 @@ TEST(ClosedLoopIdentification, ProjectionAndSpectralRemoveTheBiasOfDirectOls) {
   // Projection and spectral: no rigid-body parameter biased by 3 σ (a mean of 4 seeds spreads by
   // 0.5). The shoulder's Fv1 and Fc1 stay biased by about 4 σ: the preparation keeps only the
   // reference's 4 harmonics, so sign(q̂') switches where the band-limited velocity does, not the
-  // loop's; a noise-free run shows the same offsets (docs/methods/projection.md).
+  // loop's; a noise-free run shows the same offsets (docs/methods/closed_loop.md).
   for (int k = 1; k < kMethods; ++k)
     for (Eigen::Index i = 0; i < mean_z.rows(); ++i)
       if (names[static_cast<size_t>(i)].rfind("F", 0) != 0 &&

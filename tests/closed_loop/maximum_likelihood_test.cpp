@@ -267,7 +267,7 @@ TEST(MaximumLikelihood, ErrorsInVariablesBiasOlsButNotMaximumLikelihood) {
   // Half the noise_of_size(1) levels: σ_q̈ = 0.75 rad/s² on q̈ of a few rad/s². At twice this the
   // noise is no longer small against the regressor's curvature (q̇² and sin q terms: eq. 16's
   // linearisation) and 12 of 72 truths fall outside the 99.9 % intervals
-  // (docs/methods/maximum_likelihood.md).
+  // (docs/methods/closed_loop.md).
   const MeasurementNoise noise = noise_of_size(0.5);
   constexpr int kSeeds = 8;
   Eigen::VectorXd ols_z, ml_z;

@@ -13,7 +13,7 @@
 
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/statistics.hpp"
-#include "estimation_support.hpp"
+#include "support/estimation_support.hpp"
 
 namespace dynid {
 namespace {

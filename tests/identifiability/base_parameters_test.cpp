@@ -212,8 +212,8 @@ TEST(BaseParametersTree, EqualsTheDenseSweepOnSpecialGeometry) {
 
 // Issue 10: `model --base` on 500 joints ran for minutes at 2 GB and 2000 joints ended in
 // std::bad_alloc. A 1000-joint chain now loads and gets its base parameters (timing in
-// bench/model_bench.cpp). Correctness: (1) the base model reproduces the full model's torques on
-// states the computation never saw (a regressor row of the full model is the oracle); (2) the
+// bench/model/model_bench.cpp). Correctness: (1) the base model reproduces the full model's torques
+// on states the computation never saw (a regressor row of the full model is the oracle); (2) the
 // regrouping is local, so the count grows by exactly 7 per generic revolute link (10 parameters,
 // 3 regrouped into the parent: Khalil & Dombre, "Modeling, Identification and Control of Robots",
 // 2002, §9.5), compared with the dense sweep on the first 12 links.

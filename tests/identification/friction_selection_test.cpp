@@ -5,7 +5,7 @@
 // cut-off, white intervals) misses the true friction and has the larger friction error; the default
 // (filtered expected-sign columns, noise-aware threshold, automatic cut-off, HAC intervals) covers
 // it. Fixed seeds. With 1e-3 rad of noise fed back, closed-loop noise correlation biases every rule
-// (docs/methods/estimation.md §6).
+// (docs/methods/identification.md §3).
 #include <cmath>
 #include <string>
 

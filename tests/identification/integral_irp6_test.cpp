@@ -6,7 +6,7 @@
 // and differential estimates; seed 1 found long integrals worse than short ones, and here they are
 // better (see the second test). Which sensor error reverses that, and the example's pipeline with
 // the IRp-6's sensors: the IntegralIrp6Example tests and the on-demand study at the end
-// (docs/methods/estimation.md §7a).
+// (docs/methods/identification.md §4a).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -125,7 +125,7 @@ TEST(IntegralIrp6, TruthInsideIntervalsShortIntegralsAndDifferential) {
 // but a long row only through its two ends while its energy change grows; the friction and
 // torque-noise errors that long integrals accumulate stay small here (no torque bias, white
 // noise). The test pins the measured order (short 6.3 %, long 0.70 %, differential 0.54 % torque
-// prediction error on the run); docs/methods/estimation.md §7 has the puma560 and TX40 figures.
+// prediction error on the run); docs/methods/identification.md §4 has the puma560 and TX40 figures.
 TEST(IntegralIrp6, LongIntegralsBeatShortOnesHereUnlikeSeed1) {
   const Irp6Results& r = results();
   std::cout << "torque prediction error on the run: short integrals " << r.short_torque
@@ -280,7 +280,7 @@ TEST(IntegralIrp6Example, JointsHeldOnOneEncoderCountAreNotExcited) {
 // b_j·Δq_j over an interval. Short rows see b_j·q̇_j·h, small and of either sign; a long row sees
 // b_j·(q_j(t) − q_j(t_0)), as large as the change of potential energy it is fitted with. With seed
 // 1's friction model (no Fo column) long integrals then recover the friction worse than short
-// ones (docs/methods/estimation.md §7, "Short against long integrals").
+// ones (docs/methods/identification.md §4, "Short against long integrals").
 TEST(IntegralIrp6Example, UnmodelledTorqueOffsetMakesLongIntegralsWorseThanShortOnes) {
   const ExampleUnion& u = example_union();
   const double short_error =
@@ -298,7 +298,7 @@ TEST(IntegralIrp6Example, UnmodelledTorqueOffsetMakesLongIntegralsWorseThanShort
 // integrals; the error is the torque prediction of each estimate on the run's true states and
 // applied torques (so it measures the parameters, not the sensors). On demand only (≈ 1 min):
 //   identification_tests --gtest_also_run_disabled_tests --gtest_filter='*SensorIngredientsStudy'
-// Results in docs/methods/estimation.md §7, "Short against long integrals".
+// Results in docs/methods/identification.md §4, "Short against long integrals".
 struct Ingredient {
   const char* name;
   SensorOptions sensors;                             // in the loop (encoder, white torque noise)

@@ -87,8 +87,8 @@ double value(const Tx40Integral& r, const std::string& name) {
 }
 
 // What the integral model gets on this run with its defaults (issue 11 item 7; numbers in
-// docs/methods/estimation.md, "Integral model"): of the 12 joint friction values, Fv1, Fv2 and Fv5
-// are within 10 % of the published ones (and Fvm6); the Coulomb values are not (Fc4 with the
+// docs/methods/identification.md, "Integral model"): of the 12 joint friction values, Fv1, Fv2 and
+// Fv5 are within 10 % of the published ones (and Fvm6); the Coulomb values are not (Fc4 with the
 // wrong sign), and the torque prediction is ~7× worse than the differential model's. Why: the run
 // does not determine them to 10 % — the intervals are wider than that, and contain 11 of the 12
 // published values — and the control test below shows that the builder is not the cause. The test

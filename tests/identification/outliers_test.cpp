@@ -4,13 +4,14 @@
 // after dropping the outlier is compared with the noise level the test added.
 
 #include "dynid/identification/outliers.hpp"
+#include "dynid/identification/identify.hpp"
 
 #include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
 
-#include "estimation_support.hpp"
+#include "support/estimation_support.hpp"
 #include "support/planar2.hpp"
 
 namespace dynid {

@@ -17,8 +17,8 @@
 #include "dynid/identification/validation.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/sim/simulate_reference.hpp"
-#include "estimation_support.hpp"
 #include "support/closed_loop_runs.hpp"
+#include "support/estimation_support.hpp"
 
 namespace dynid {
 namespace {

@@ -205,7 +205,7 @@ TEST(IdentificationOracle, ResidualAutocorrelationIsMeasuredAndWarned) {
 // (TX40, Fvm6 and Fcm6) directions at 3–6e-7 of the largest singular value (differential: 2.3e-3
 // on the same data), below data_identifiability's 1e-6, so data rank 57 of 58 and 59 of 61; the
 // contract item 3 asks for still holds: those are named not excited with a warning, every
-// estimate has a finite σ, none is reported with σ = null (docs/methods/estimation.md §7).
+// estimate has a finite σ, none is reported with σ = null (docs/methods/identification.md §4).
 class SixJointKdl : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(SixJointKdl, RunWhereEveryJointMovesHasFullDataRank) {

@@ -51,6 +51,16 @@ TEST(ApplyFilterText, SetsFamilyOrderAndRipple) {
   EXPECT_THROW(apply_filter_text("butterworth:x", s), UsageError);
 }
 
+TEST(ApplyFirText, ReadsTwoLagOrders) {
+  ProjectionOptions p;
+  apply_fir_text("3,4", p);
+  EXPECT_EQ(p.m1, 3);
+  EXPECT_EQ(p.m2, 4);
+  EXPECT_THROW(apply_fir_text("3", p), UsageError);
+  EXPECT_THROW(apply_fir_text("-1,2", p), UsageError);
+  EXPECT_THROW(apply_fir_text("3,4x", p), UsageError);
+}
+
 // A result of the command line: text friction and filter, and what identify chose.
 TEST(OptionsOfStoredResult, RebuildsTheCommandLinesOptionsAndWhatIdentifyChose) {
   IdentifiedResultFile f = result_with_options({{"friction", "viscous,coulomb"},

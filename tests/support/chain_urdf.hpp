@@ -1,7 +1,7 @@
 #pragma once
 
 // URDF text of long serial chains, for the size tests of the loaders and base parameters and for
-// bench/model_bench.cpp.
+// bench/model/model_bench.cpp.
 
 #include <random>
 #include <sstream>

@@ -63,7 +63,7 @@ EquationBlock project_equations(const EquationBlock& block, const SignalProjecto
 /// disagreement; with few channels it is unreliable on its own, so each parameter's variance is
 /// the larger of the two (Angrist–Pischke 2009 §8.2.3), with the white correlations
 /// (C = S·C_white·S, S = diag(max(1, σ_cl/σ_white))): PSD, never narrower than the white one.
-/// Parameters widened by more than 20 % are named in a warning. docs/methods/projection.md.
+/// Parameters widened by more than 20 % are named in a warning. docs/methods/closed_loop.md.
 /// Returns the one-line covariance choice. Throws dynid::Error when effective_rows ≤ the
 /// parameters or `channel` has the wrong size.
 std::string projected_statistics(Estimate& estimate, const EquationBlock& block,

@@ -90,7 +90,7 @@ Estimate maximum_likelihood(const EquationBlock& block, const Eigen::MatrixXd& s
 /// Eq. 15's whitened residuals at θ (seed 2 eqs. 15–16), in the block's row order: per sample k,
 /// L_k⁻¹·b_k with b_k = τ_k − W_k·θ and S_k = L_k·L_kᵀ = B_k σ² B_kᵀ, so that eq. 15's cost is
 /// ½‖result‖². With `jacobian`, also their exact derivative with respect to θ (rows × p; J is
-/// linear in θ, docs/methods/maximum_likelihood.md "Jacobian"), the one maximum_likelihood()
+/// linear in θ, docs/methods/closed_loop.md "Jacobian"), the one maximum_likelihood()
 /// hands to Ceres. Arguments as maximum_likelihood() (θ for `start`). Throws dynid::Error as
 /// maximum_likelihood(), and when some S_k is not positive definite.
 Eigen::VectorXd maximum_likelihood_residual(const EquationBlock& block,
@@ -117,7 +117,7 @@ MeasurementNoise processed_noise(const SensorNoise& given, const SignalOptions& 
 /// fixed-seed Gaussian matrix) and D central differences at `ts` [s] (exact to (hω·ts)²/6 on a
 /// band far below Nyquist). Raw σ from `given` where set, else the remainders as white noise:
 /// σ_q = processed.position_noise_std (q − q̂), σ_τ = torque_remainder_std (τ − τ̂).
-/// docs/methods/maximum_likelihood.md "After a projection". `how` receives one line. Throws
+/// docs/methods/closed_loop.md "After a projection". `how` receives one line. Throws
 /// dynid::Error when σ_τ is not > 0 or the sizes do not match.
 MeasurementNoise projected_noise(const SensorNoise& given, const SignalProjector& projector,
                                  double ts, const ProcessedRecord& processed,

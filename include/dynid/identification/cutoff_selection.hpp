@@ -46,7 +46,7 @@ struct CutoffSelection {
 /// gain nothing from it. The lowest error wins; the spectral value is kept when there is nothing
 /// to choose (f_s at the upper bound) or the record cannot be split (too short, rank-deficient
 /// half). With a given cut-off or without filtering, options.signal is returned unchanged.
-/// Derivation and measurements: docs/methods/signal.md ("Cut-off by held-out prediction").
+/// Derivation and measurements: docs/methods/identification.md ("Cut-off by held-out prediction").
 /// Throws what preprocess() throws for an unusable record.
 CutoffSelection select_cutoff(const Model& model, const JointRecord& record,
                               const IdentifyOptions& options,

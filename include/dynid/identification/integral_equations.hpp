@@ -41,7 +41,7 @@ EquationBlock integral_equations(const Model& model, const ParameterLayout& layo
 /// fixed 10 Hz cut-off (the automatic rule, tuned for q̈, chose 1.1 Hz on a simulated run and the
 /// filter's distortion of τᵀq̇ then dominated: 50 % torque error against 12 % at 10 Hz) and no
 /// decimation (the power is integrated at the full rate). Measurements in
-/// docs/methods/estimation.md, "Integral model".
+/// docs/methods/identification.md, "Integral model".
 SignalOptions integral_signal_options();
 
 }  // namespace dynid

@@ -6,7 +6,7 @@ namespace dynid {
 
 /// Row weighting of the integral model: each row is divided by the relative standard deviation
 /// of its error under one noise model, normalised to RMS 1 over the block (y stays in joules on
-/// average). Measurements in docs/methods/estimation.md, "Integral model".
+/// average). Measurements in docs/methods/identification.md, "Integral model".
 enum class IntegralWeighting {
   kNone,  ///< rows as they are
   /// White torque noise: work of std ∝ √(Σ_k h_k²‖q̇_k‖²) over the interval's steps (fast
@@ -19,13 +19,13 @@ enum class IntegralWeighting {
   kEndpointMomentum,
 };
 
-/// Options of integral_equations() (seed 1 eqs. 8–18, 32–35; docs/methods/estimation.md,
+/// Options of integral_equations() (seed 1 eqs. 8–18, 32–35; docs/methods/identification.md,
 /// "Integral model").
 struct IntegralOptions {
   /// Interval length [s], rounded to a whole number of steps of the processed record; the run is
   /// cut into consecutive, non-overlapping intervals from its first sample (samples after the
   /// last whole interval are not used). 0 = kAutoIntervalSteps steps. Seed 1 used 5 ms at 0.5 ms
-  /// sampling; 10 ms was among the best short intervals measured (docs/methods/estimation.md,
+  /// sampling; 10 ms was among the best short intervals measured (docs/methods/identification.md,
   /// "Integral model"), and longer ones lost accuracy on the TX40 run.
   double interval = 0.01;
   /// Long integrals (seed 1 §IV): interval k runs from the first sample to the end of short

@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "dynid/closed_loop/closed_loop_options.hpp"
 #include "dynid/identification/record.hpp"
 #include "dynid/regressor/parameter_layout.hpp"
 
@@ -21,5 +22,9 @@ ParameterLayout friction_layout(const std::string& text, bool armature);
 /// "chebyshev[:ORDER[:RIPPLE_DB]]" set family, order (Chebyshev default 8, seed 2 §3.4) and
 /// ripple [dB]. Throws dynid::UsageError naming the forms.
 void apply_filter_text(const std::string& text, SignalOptions& signal);
+
+/// The projection's FIR orders from `--fir M1,M2` (seed 2 eqs. 10–11: M1 future and M2 past
+/// reference lags, integers ≥ 0) into projection.m1, m2. Throws dynid::UsageError naming the form.
+void apply_fir_text(const std::string& text, ProjectionOptions& projection);
 
 }  // namespace dynid

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include "dynid/estimation/estimate.hpp"
 #include "dynid/identification/outlier_options.hpp"
 #include "dynid/identification/record.hpp"
 

@@ -46,7 +46,7 @@ struct SignalOptions {
   /// the Coulomb law below a physical velocity band; below the noise the sign of dq is unknown),
   /// and the Coulomb columns are the filtered expected sign (as with filter_coulomb_columns): with
   /// a low cut-off the filtered torque's smeared Coulomb step otherwise biases Fv high and Fc low
-  /// (docs/methods/estimation.md, "Friction near zero velocity").
+  /// (docs/methods/identification.md, "Friction near zero velocity").
   std::vector<double> zero_velocity;
   /// Automatic zero-velocity rule: fraction of max|dq_j| of the processed record (the band where
   /// real joint friction is not Fc·sign(dq): pre-sliding, Stribeck; 1 % matches FIGAROH's TX40).

@@ -51,7 +51,7 @@ struct CompletedModel {
 ///   options.max_relative_std take the nominal model's component, z = ẑ + V_U·V_Uᵀ·(z⁰ − ẑ);
 ///   the others keep the estimate's. The eigen-directions are independent estimates (exactly so
 ///   for a white covariance C = σ²(WᵀW)⁻¹), and along V_U the data change the prediction by
-///   little: ‖W·S·v‖ = σ/√λ (docs/methods/experiments.md, "Completing a model"). Without
+///   little: ‖W·S·v‖ = σ/√λ (docs/methods/physical.md, "Completing a model"). Without
 ///   `covariance` (empty) only the not excited ones are filled and a warning says so.
 /// `names`/`values` (size m) are the result's parameters; the first e of them were estimated, with
 /// `std_devs` (size e ≤ m, NaN where unknown; e = 0: none is badly determined) and `covariance`

@@ -35,7 +35,7 @@ struct NoiseFloor {
 /// highest band below rate/4 that stands signal_to_noise above it. Differencing first keeps the
 /// window's leakage from a large slow motion below the floor. q is m × n at rate_hz; records
 /// with fewer than 129 samples give NaN. Throws dynid::Error for a rate that is not > 0.
-/// Derivation: docs/methods/signal.md ("Noise floor and automatic cut-off").
+/// Derivation: docs/methods/signal.md ("Noise floor and spectral cut-off rule").
 NoiseFloor position_noise_floor(const Eigen::Ref<const Eigen::MatrixXd>& q, double rate_hz,
                                 const NoiseFloorOptions& options = {});
 

@@ -7,7 +7,7 @@
 // printed figure is each estimate's torque-prediction error on run B (validate_torques). Then the
 // treatments for correlated rows and errors in the regressor on the processed equations: AR(1)
 // prewhitening, MA(1) GLS (the shared end points of adjacent intervals), instrumental variables.
-// Not a benchmark: its table is in docs/methods/estimation.md ("Integral model").
+// Not a benchmark: its table is in docs/methods/identification.md ("Integral model").
 // Run: ./build/bench/integral_error_bench [position-noise-scale [torque-noise-scale [after]]]
 // (after = 1: encoder noise added to the log of a run with exact feedback, no jitter);
 // ./build/bench/integral_error_bench window [after]: endpoint-velocity window study;
@@ -29,7 +29,7 @@
 #include <Eigen/QR>
 #include <Eigen/SVD>
 
-#include "../tests/identification/integral_support.hpp"
+#include "../../tests/identification/integral_support.hpp"
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/identification/identify.hpp"
 #include "dynid/identification/integral_equations.hpp"

@@ -6,7 +6,7 @@
 
 #include <benchmark/benchmark.h>
 
-#include "../tests/support/chain_urdf.hpp"
+#include "../../tests/support/chain_urdf.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
 #include "dynid/model/urdf_loader.hpp"
 

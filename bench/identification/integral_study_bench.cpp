@@ -4,7 +4,7 @@
 // identifies on run A with the differential model (identify() defaults) and with the integral
 // model over a grid of signal processing and interval choices, and prints each estimate's
 // torque-prediction error on run B (validate_torques with the differential defaults).
-// Not a benchmark: a study whose table is in docs/methods/estimation.md ("Integral model").
+// Not a benchmark: a study whose table is in docs/methods/identification.md ("Integral model").
 // Run: ./build/bench/integral_study_bench [position-noise-scale [torque-noise-scale]] (1 1 = the
 // noise above; 0 0 = noise-free).
 #include <cmath>
@@ -12,7 +12,7 @@
 #include <cstdlib>
 #include <vector>
 
-#include "../tests/identification/integral_support.hpp"
+#include "../../tests/identification/integral_support.hpp"
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/identification/identify.hpp"
 #include "dynid/identification/integral_equations.hpp"
