@@ -29,7 +29,8 @@ struct ExciteCliOptions {
   int harmonics = 5, starts = 4, max_evaluations = 3000;
   double f0 = 0.1, f_max = 0.0, rate = 100.0, max_time = 10.0, z_min = -1e300;
   double limit_fraction = 1.0;
-  bool quiet = false;  // --quiet
+  bool quiet = false;             // --quiet
+  bool allow_violations = false;  // --allow-violations
   std::vector<double> dq_max, ddq_max, tau_max;
   unsigned seed = 20261123;
   bool no_rest = false;
@@ -211,6 +212,41 @@ void run_joint_experiment(const ExciteCliOptions& o) {
             << "wrote " << o.out << '\n';
 }
 
+// Why an optimised excitation is refused: its tightest constraint (the largest violation relative
+// to the limit's own size), what it reaches, and the flag that relaxes it.
+std::string violation_text(const ExciteCliOptions& o, const ExcitationResult& r) {
+  std::string s = "no excitation of '" + o.robot + "' found meets its constraints (best of " +
+                  std::to_string(o.starts) + (o.starts == 1 ? " start, " : " starts, ") +
+                  std::to_string(r.evaluations) + " evaluations; condition number " +
+                  short_number(r.condition_number) + ")";
+  const ConstraintMargin* m = tightest_constraint(r);
+  if (m == nullptr) return s;
+  const bool lower = m->name.find(" min") != std::string::npos;
+  s += ": the tightest, " + m->name + ", reaches " + short_number(m->reached) + " " + m->unit +
+       (lower ? " below" : " above") + " its limit " + short_number(m->limit) + " " + m->unit +
+       " at t = " + short_number(m->time) + " s; ";
+  const std::string fraction =
+      o.limit_fraction < 1.0 ? " or --limit-fraction (now " + short_number(o.limit_fraction) + ")"
+                             : "";
+  const auto starts_with = [&](const char* prefix) { return m->name.rfind(prefix, 0) == 0; };
+  if (starts_with("torque")) {
+    s += "raise --torque-limit (default: the model's effort)" + fraction;
+  } else if (starts_with("velocity")) {
+    s += "raise --velocity-limit (default: the model's velocity limit)" + fraction;
+  } else if (starts_with("acceleration")) {
+    s += "raise --acceleration-limit" + fraction;
+  } else if (starts_with("position")) {
+    s += o.limit_fraction < 1.0
+             ? "raise --limit-fraction (now " + short_number(o.limit_fraction) + ")"
+             : "widen the model's position limits or lower --f0/--harmonics";
+  } else if (starts_with("workspace z_min")) {
+    s += "lower --z-min";
+  } else {
+    s += "widen the " + m->name;
+  }
+  return s + ", or search longer (--starts, --max-evaluations, --max-time)";
+}
+
 void run_excite(const ExciteCliOptions& o) {
   if (o.family != "fourier") {
     if (o.family != "slope" && o.family != "bang-bang" && o.family != "trapezoid" &&
@@ -219,6 +255,10 @@ void run_excite(const ExciteCliOptions& o) {
                        o.family + "'");
     }
     if (!o.json.empty()) throw UsageError("--json is written by --family fourier only");
+    if (o.allow_violations) {
+      throw UsageError("--allow-violations is for the optimised --family fourier; a " + o.family +
+                       " reference is checked against its limits and refused when it exceeds one");
+    }
     run_joint_experiment(o);
     return;
   }
@@ -233,6 +273,11 @@ void run_excite(const ExciteCliOptions& o) {
     if (!o.json.empty())
       throw UsageError(
           "--json is written by the optimised --family fourier only (without --joint)");
+    if (o.allow_violations) {
+      throw UsageError(
+          "--allow-violations is for the optimised --family fourier (without --joint); a "
+          "one-joint reference is checked against its limits and refused when it exceeds one");
+    }
     run_joint_experiment(o);
     return;
   }
@@ -265,6 +310,16 @@ void run_excite(const ExciteCliOptions& o) {
     throw Error("the optimised trajectory of '" + o.robot +
                 "' does not excite every base parameter (condition number infinite); use more "
                 "--harmonics, a higher --fmax or wider limits");
+  }
+  if (!result.constraints_satisfied) {
+    // A trajectory outside the robot's limits is not an excitation to run: refused, unless asked
+    // for (to inspect it, or to relax the limits knowingly).
+    if (!o.allow_violations) {
+      throw Error(violation_text(o, result) +
+                  "; or write it anyway with --allow-violations (nothing was written)");
+    }
+    std::cerr << "warning: " << one_line(violation_text(o, result))
+              << " (written anyway: --allow-violations)\n";
   }
   std::cout << excitation_text(result);
   if (!o.json.empty()) write_json(o.json, excitation_to_json(result));
@@ -315,6 +370,9 @@ void add_excite_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--quiet,-q", o->quiet,
                 "No progress line on stderr (shown only when stderr is a terminal)");
+  cmd->add_flag("--allow-violations", o->allow_violations,
+                "Write the optimised trajectory even when it violates a limit (a warning names "
+                "the tightest); without it that is an error and nothing is written");
   cmd->add_flag("--no-rest", o->no_rest,
                 "Do not force zero velocity/acceleration at start and end");
   cmd->add_option("--family", o->family,

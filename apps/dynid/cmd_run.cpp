@@ -10,6 +10,7 @@
 #include "dynid/common/error.hpp"
 #include "dynid/common/progress.hpp"
 #include "dynid/workflow/project.hpp"
+#include "file_flags.hpp"
 
 namespace dynid::cli {
 namespace {
@@ -31,7 +32,8 @@ CommandTable command_table() {
     for (const CLI::Option* o : (*sub)->get_options()) {
       for (const std::string& name : o->get_lnames()) {
         flags.push_back({name, o->get_expected_max() > 0,
-                         o->get_multi_option_policy() == CLI::MultiOptionPolicy::TakeAll});
+                         o->get_multi_option_policy() == CLI::MultiOptionPolicy::TakeAll,
+                         writes_file(command, name)});
       }
     }
     return true;

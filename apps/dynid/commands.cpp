@@ -1,6 +1,7 @@
 // add_commands(): the one list of dynid's subcommands (main.cpp and fuzz/cli_fuzzer.cpp).
 #include "commands.hpp"
 
+#include "file_flags.hpp"
 #include "flag_checks.hpp"
 
 namespace dynid::cli {
@@ -20,6 +21,7 @@ void add_commands(CLI::App& app) {
   add_report_command(app);
   add_run_command(app);
   check_numeric_flags(app);
+  check_file_flags(app);
 }
 
 }  // namespace dynid::cli

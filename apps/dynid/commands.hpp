@@ -18,8 +18,9 @@ struct SignalOptions;
 
 namespace dynid::cli {
 
-/// Registers every subcommand below on `app` and the NaN/Inf check of their numeric flags
-/// (flag_checks.hpp): the one definition of the command line, used by main() and the CLI fuzzer.
+/// Registers every subcommand below on `app`, the NaN/Inf check of their numeric flags
+/// (flag_checks.hpp) and the check that no output is one of the inputs (file_flags.hpp): the one
+/// definition of the command line, used by main(), `dynid run` and the CLI fuzzer.
 void add_commands(CLI::App& app);
 
 /// `dynid model`: robot summary and JSON export (cmd_model.cpp).

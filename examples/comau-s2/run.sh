@@ -18,8 +18,9 @@
 # Usage: examples/comau-s2/run.sh [OUT_DIR]   (default comau-s2-out; DYNID=path/to/dynid)
 # Environment: PERIODS (25, as in the paper), RATE (control and logging rate, 1000 Hz as in the
 #   paper; a multiple of 200, the rate the averaged periods are resampled to), SEED (1). Runtime
-#   on 2 busy shared cores: 5-7 min with the defaults; PERIODS=3 RATE=200 (the test's setting)
-#   about 9 s of CPU, 27-80 s wall clock.
+#   measured 2026-12-02 on a 2-core Intel Xeon VM shared with other builds (load average 3-6):
+#   17-21 s wall clock (17-21 s of CPU) with the defaults; PERIODS=3 RATE=200 (the test's
+#   setting) 5 s wall clock.
 set -euo pipefail
 if [ $# -gt 1 ]; then
   echo "usage: $0 [OUT_DIR]" >&2

@@ -362,8 +362,43 @@ class Evaluator {
 
   std::vector<ConstraintMargin> margins() const {
     std::vector<ConstraintMargin> out;
-    for (size_t gi = 0; gi < groups_.size(); ++gi)
-      out.push_back({groups_[gi].name, groups_[gi].limit - worst_[gi], worst_time_[gi]});
+    for (size_t gi = 0; gi < groups_.size(); ++gi) {
+      const Group& gr = groups_[gi];
+      ConstraintMargin m;
+      m.name = gr.name;
+      m.margin = gr.limit - worst_[gi];
+      m.time = worst_time_[gi];
+      // Lower bounds are evaluated negated (−q ≤ −q_min): report them as given.
+      const bool lower =
+          gr.kind == Kind::kPosLower || gr.kind == Kind::kFloor || gr.kind == Kind::kBoxMin;
+      m.limit = lower ? -gr.limit : gr.limit;
+      m.reached = lower ? -worst_[gi] : worst_[gi];
+      const bool prismatic =
+          gr.kind != Kind::kFloor && gr.kind != Kind::kBoxMin && gr.kind != Kind::kBoxMax &&
+          model_.joints[static_cast<size_t>(gr.index)].type == JointType::kPrismatic;
+      switch (gr.kind) {
+        case Kind::kPosUpper:
+        case Kind::kPosLower:
+          m.unit = prismatic ? "m" : "rad";
+          break;
+        case Kind::kVel:
+          m.unit = prismatic ? "m/s" : "rad/s";
+          break;
+        case Kind::kAcc:
+          m.unit = prismatic ? "m/s²" : "rad/s²";
+          break;
+        case Kind::kTorque:
+          m.unit = prismatic ? "N" : "N·m";
+          break;
+        case Kind::kFloor:
+        case Kind::kBoxMin:
+        case Kind::kBoxMax:
+          m.unit = "m";
+          break;
+      }
+      m.relative = m.margin / gr.scale;
+      out.push_back(m);
+    }
     return out;
   }
 
@@ -508,6 +543,13 @@ void constraints_cb(unsigned m, double* result, unsigned, const double* x, doubl
 }
 
 }  // namespace
+
+const ConstraintMargin* tightest_constraint(const ExcitationResult& r) {
+  const ConstraintMargin* out = nullptr;
+  for (const ConstraintMargin& m : r.margins)
+    if (out == nullptr || !(m.relative >= out->relative)) out = &m;  // NaN: the most violated
+  return out;
+}
 
 ExcitationResult evaluate_excitation(const Model& model, const FourierCoefficients& coefficients,
                                      const ExcitationOptions& options, int samples_per_period) {

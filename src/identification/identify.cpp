@@ -81,6 +81,38 @@ void not_excited_warnings(const Model& model, const ParameterLayout& layout,
 
 }  // namespace
 
+Eigen::VectorXd estimated_base_values(const IdentificationResult& result,
+                                      const Eigen::VectorXd& base_values) {
+  const std::vector<std::string>& all = result.base.names;
+  const auto kept = static_cast<Eigen::Index>(result.names.size());
+  const auto unexcited = static_cast<Eigen::Index>(result.not_excited.size());
+  if (base_values.size() != static_cast<Eigen::Index>(all.size())) {
+    throw Error("estimated_base_values: " + std::to_string(base_values.size()) +
+                " values for the " + std::to_string(all.size()) + " base parameters");
+  }
+  if (unexcited > 0 &&
+      (result.data_regrouping.rows() != kept || result.data_regrouping.cols() != unexcited)) {
+    throw Error("estimated_base_values: data_regrouping is " +
+                std::to_string(result.data_regrouping.rows()) + " x " +
+                std::to_string(result.data_regrouping.cols()) + " for " + std::to_string(kept) +
+                " estimates and " + std::to_string(unexcited) + " parameters not excited");
+  }
+  const auto at = [&](const std::string& name) {
+    const auto it = std::find(all.begin(), all.end(), name);
+    if (it == all.end()) {
+      throw Error("estimated_base_values: '" + name + "' is not a base parameter of the result");
+    }
+    return base_values[it - all.begin()];
+  };
+  Eigen::VectorXd out(kept);
+  for (Eigen::Index i = 0; i < kept; ++i) {
+    out[i] = at(result.names[static_cast<size_t>(i)]);
+    for (Eigen::Index j = 0; j < unexcited; ++j)
+      out[i] += result.data_regrouping(i, j) * at(result.not_excited[static_cast<size_t>(j)]);
+  }
+  return out;
+}
+
 IdentificationResult identify(const Model& model, const JointRecord& record,
                               const IdentifyOptions& options) {
   return identify(model, std::vector<JointRecord>{record}, options);

@@ -151,6 +151,22 @@ EquationBlock select_columns(const EquationBlock& block, const std::vector<int>&
   return out;
 }
 
+EquationBlock select_named_columns(const EquationBlock& block,
+                                   const std::vector<std::string>& names) {
+  std::vector<int> columns;
+  columns.reserve(names.size());
+  for (const std::string& name : names) {
+    const auto it = std::find(block.columns.begin(), block.columns.end(), name);
+    if (it == block.columns.end()) {
+      throw Error("parameter '" + name +
+                  "' is not a column of these equations; build them with the model, friction set "
+                  "and coupling of the result");
+    }
+    columns.push_back(static_cast<int>(it - block.columns.begin()));
+  }
+  return select_columns(block, columns);
+}
+
 DataIdentifiability data_identifiability(const EquationBlock& block,
                                          const DataIdentifiabilityOptions& options) {
   const Eigen::Index p = block.W.cols();

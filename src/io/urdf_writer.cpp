@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "dynid/common/error.hpp"
+#include "dynid/io/atomic_file.hpp"
 
 namespace dynid {
 
@@ -113,22 +114,7 @@ std::string to_urdf(const Model& model, const UrdfWriteOptions& options) {
 }
 
 void write_urdf(const Model& model, const std::string& path, const UrdfWriteOptions& options) {
-  const std::string text = to_urdf(model, options);
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    if (!f)
-      throw Error("cannot write URDF '" + path + "'; check that the folder exists and is writable");
-    f << text;
-    if (!f.flush()) {
-      std::remove(tmp.c_str());
-      throw Error("failed writing URDF '" + path + "'; check free disk space");
-    }
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw Error("cannot rename '" + tmp + "' to '" + path + "'");
-  }
+  write_text_atomic(path, to_urdf(model, options));
 }
 
 }  // namespace dynid

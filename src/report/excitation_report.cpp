@@ -28,7 +28,13 @@ std::vector<double> to_std(const Eigen::VectorXd& v) {
 nlohmann::json excitation_to_json(const ExcitationResult& r) {
   nlohmann::json margins = nlohmann::json::array();
   for (const auto& m : r.margins) {
-    margins.push_back({{"name", m.name}, {"margin", json_number(m.margin)}, {"time", m.time}});
+    margins.push_back({{"name", m.name},
+                       {"margin", json_number(m.margin)},
+                       {"time", m.time},
+                       {"limit", json_number(m.limit)},
+                       {"reached", json_number(m.reached)},
+                       {"unit", m.unit},
+                       {"relative", json_number(m.relative)}});
   }
   nlohmann::json a = nlohmann::json::array(), b = nlohmann::json::array();
   for (int i = 0; i < r.coefficients.dof(); ++i) {

@@ -964,8 +964,19 @@ nlohmann::json energy_plot_json(const Model& model, const IdentificationResult& 
   integral.weighting = IntegralWeighting::kNone;
   const bool coupling =
       static_cast<int>(result.base.layout_names.size()) > options.layout.columns(model.dof());
-  const EquationBlock block = select_base_columns(
-      integral_equations(model, options.layout, coupling, result.processed, integral), result.base);
+  // The estimate lives on result.names: the base columns the data determine. With parameters
+  // not excited (result.not_excited) those are fewer than the base set, and on these data the
+  // kept estimates already hold the not-excited ones' share (data_regrouping), so W_kept·θ̂
+  // predicts the measured work.
+  if (result.estimate.x.size() != static_cast<Eigen::Index>(result.names.size())) {
+    throw Error("energy_plot_json: the estimate has " + std::to_string(result.estimate.x.size()) +
+                " values for " + std::to_string(result.names.size()) + " parameter names");
+  }
+  const EquationBlock block = select_named_columns(
+      select_base_columns(
+          integral_equations(model, options.layout, coupling, result.processed, integral),
+          result.base),
+      result.names);
   const Eigen::VectorXd predicted = block.W * result.estimate.x;
   const auto keep = display_indices(block.y.size(), plot_options.max_points);
   const int digits = plot_options.significant_digits;

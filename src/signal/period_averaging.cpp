@@ -294,6 +294,19 @@ bool has_index_suffix(const std::string& name, const std::string& prefix) {
 constexpr double kReferenceSpread = 0.01;
 // A measured position's noise is far below its motion in any identification run.
 constexpr double kPositionSpread = 0.1;
+// A column whose whole range is within this many of its sample-to-sample noise σ does not move:
+// the range of up to 10⁷ samples of white Gaussian noise is about 10.4 σ.
+constexpr double kNoiseRange = 12.0;
+
+// The sample-to-sample noise σ of a column, whatever the period: RMS of its second differences
+// over √6 (white noise of std σ gives σ√6; a motion sampled at ω adds only (ω·Ts)² of its
+// amplitude). 0 for fewer than 3 samples.
+double difference_noise_std(const Eigen::Ref<const Eigen::VectorXd>& x) {
+  const Eigen::Index m = x.size();
+  if (m < 3) return 0.0;
+  const Eigen::VectorXd d2 = x.tail(m - 2) - 2.0 * x.segment(1, m - 2) + x.head(m - 2);
+  return std::sqrt(d2.squaredNorm() / static_cast<double>(m - 2) / 6.0);
+}
 
 }  // namespace
 
@@ -355,7 +368,10 @@ std::vector<std::string> check_period_repeats(const TimedPeriodAverage& a,
                   "repeats to its interpolation error)" +
                   own + "; check --period/--f0");
     }
-    if (has_index_suffix(names[c], "q") && spread > kPositionSpread)
+    // A held joint's range is its noise: its spread is a large part of it whatever the period
+    // (a wrong period cannot smear a constant), so it says nothing about the period.
+    if (has_index_suffix(names[c], "q") && spread > kPositionSpread &&
+        range > kNoiseRange * difference_noise_std(col))
       warnings.push_back(names[c] + " spreads by " + short_number(100.0 * spread) +
                          " % of its range across the periods of " + short_number(period) +
                          " s: the noise statistics and the mean period are doubtful (noise, "

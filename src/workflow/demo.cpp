@@ -143,7 +143,10 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
     io.signal.zero_velocity[j] = 0.05 * traj.dq.col(j).cwiseAbs().maxCoeff();
   }
   out.identification = identify(model, rec, io);
-  out.truth = out.identification.base.reduce(io.layout.parameters(model));
+  // The truth of each estimate: its base parameter, plus the share of any base parameter these
+  // data do not excite (IdentificationResult::data_regrouping).
+  out.truth = estimated_base_values(out.identification,
+                                    out.identification.base.reduce(io.layout.parameters(model)));
   nlohmann::json used = {{"robot", o.robot},
                          {"friction", "viscous,coulomb,offset"},
                          {"armature", true},
@@ -197,8 +200,14 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
     << " base parameters, " << o.periods << " periods averaged, CI level "
     << 100 * out.identification.estimate.confidence_level << " %)\n";
   t << "name             true   identified      %std   truth in CI\n";
+  if (!out.identification.not_excited.empty()) {
+    t << "not excited by the run (not estimated; the estimates below include their share):";
+    for (const auto& name : out.identification.not_excited) t << ' ' << name;
+    t << '\n';
+  }
   int inside = 0;
-  for (int i = 0; i < out.identification.rank; ++i) {
+  const auto estimated = static_cast<int>(out.identification.names.size());
+  for (int i = 0; i < estimated; ++i) {
     const bool in = out.identification.estimate.ci_lower[i] <= out.truth[i] &&
                     out.truth[i] <= out.identification.estimate.ci_upper[i];
     inside += in;
@@ -213,7 +222,7 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
                 "joint rows fitted\nvalidation on a trapezoidal move: relative torque error over "
                 "every row %.2f %%; without the %ld of %ld near-still rows (|dq_j| below the "
                 "fit's thresholds) %.2f %%\nvalidation RMS per joint, every row:",
-                inside, out.identification.rank, out.excitation.condition_number,
+                inside, estimated, out.excitation.condition_number,
                 out.excitation.constraints_satisfied ? "satisfied" : "violated",
                 100 * out.identification.relative_error, static_cast<long>(out.identification.rows),
                 100 * v.relative_error_all_rows, static_cast<long>(v.rows_excluded),

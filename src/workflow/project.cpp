@@ -1,15 +1,26 @@
 #include "dynid/workflow/project.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "dynid/common/error.hpp"
+#include "dynid/io/atomic_file.hpp"
+#include "dynid/io/csv_reader.hpp"
+#include "dynid/sim/pid_gains.hpp"
 
 namespace dynid {
 
@@ -42,8 +53,17 @@ namespace {
 const char* const kOutputKey = "output";
 const char* const kRobotKey = "robot";
 const char* const kDataKey = "data";
-// Written beside the results; its presence marks a folder a previous `dynid run` may replace.
+// Written beside the results: the command lines of the stages.
 const char* const kCommandsFile = "commands.txt";
+// The marker of a folder dynid run wrote: its first line is kMarkerHeader, then the state
+// ("state: writing <pid>" while the stages run in <output>.partial, "state: complete" after), the
+// project file and one "file: NAME" line per entry of the folder. A folder is replaced only when
+// it holds this marker and nothing the marker does not list.
+const char* const kMarkerFile = ".dynid-run";
+const char* const kMarkerHeader =
+    "# dynid run output folder: dynid run replaces it while this file lists everything in it";
+// Above this, a project file or a marker is not what it claims to be.
+constexpr std::size_t kMaxProjectFileBytes = std::size_t{16} << 20;
 
 std::string join(const std::vector<std::string>& words, const char* sep = ", ") {
   std::string s;
@@ -71,8 +91,207 @@ std::string resolve(const std::string& value, const fs::path& project_dir) {
   return fs::is_regular_file(beside, ec) ? beside.lexically_normal().string() : value;
 }
 
+// ---- Reading with a cap -------------------------------------------------------------------------
+
+// The whole of a regular file, at most `cap` bytes (what is read counts, not what stat says).
+// Opened without blocking, so a FIFO planted at the name is refused instead of waited on; a
+// symbolic link is followed unless `no_follow`. Throws dynid::Error "WHAT 'PATH': ...; FIX".
+std::string read_regular_file(const fs::path& path, std::size_t cap, const std::string& what,
+                              bool no_follow = false) {
+  const std::string shown = what + " '" + path.string() + "'";
+  const int fd = ::open(
+      path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY | (no_follow ? O_NOFOLLOW : 0));
+  if (fd < 0) {
+    throw Error(shown + ": cannot open (" + std::strerror(errno) + "); check the path");
+  }
+  struct Close {
+    int fd;
+    ~Close() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    throw Error(shown + " is not a regular file (a folder, device or FIFO); give a file");
+  }
+  const auto too_large = [&] {
+    throw Error(shown + " is larger than " + std::to_string(cap >> 20) +
+                " MiB, the limit for this input; give a smaller file or split it");
+  };
+  if (static_cast<std::size_t>(st.st_size) > cap) too_large();
+  std::string text;
+  char buffer[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw Error(shown + ": read error (" + std::strerror(errno) + "); check the file");
+    if (n == 0) break;
+    if (text.size() + static_cast<std::size_t>(n) > cap) too_large();
+    text.append(buffer, static_cast<std::size_t>(n));
+  }
+  return text;
+}
+
+// ---- The marker of a folder dynid run wrote -----------------------------------------------------
+
+struct Marker {
+  bool valid = false;
+  bool complete = false;  // else "writing"
+  long pid = 0;           // of the run writing it
+  std::set<std::string> files;
+};
+
+Marker read_marker(const fs::path& folder) {
+  Marker m;
+  std::string text;
+  try {
+    // Not followed: a link planted in place of the marker does not vouch for the folder.
+    text = read_regular_file(folder / kMarkerFile, std::size_t{1} << 20, "marker", true);
+  } catch (const Error&) {
+    return m;
+  }
+  std::istringstream in(text);
+  std::string line;
+  if (!std::getline(in, line) || line != kMarkerHeader) return m;
+  if (!std::getline(in, line)) return m;
+  if (line == "state: complete") {
+    m.complete = true;
+  } else if (line.rfind("state: writing ", 0) == 0) {
+    char* end = nullptr;
+    const char* digits = line.c_str() + std::strlen("state: writing ");
+    m.pid = std::strtol(digits, &end, 10);
+    if (end == digits || *end != '\0' || m.pid <= 0) return m;
+  } else {
+    return m;
+  }
+  while (std::getline(in, line)) {
+    if (line.rfind("file: ", 0) == 0) m.files.insert(line.substr(6));
+  }
+  m.valid = true;
+  return m;
+}
+
+void write_marker(const fs::path& folder, const fs::path& project, bool complete) {
+  std::string text = std::string(kMarkerHeader) + "\n";
+  text += complete ? std::string("state: complete\n")
+                   : "state: writing " + std::to_string(static_cast<long>(::getpid())) + "\n";
+  std::string shown = project.string();
+  std::replace(shown.begin(), shown.end(), '\n', '?');
+  text += "project: " + shown + "\n";
+  if (complete) {
+    std::set<std::string> names = {kMarkerFile};
+    for (const auto& e : fs::directory_iterator(folder)) names.insert(e.path().filename().string());
+    for (const auto& n : names) {
+      if (n.find('\n') == std::string::npos) text += "file: " + n + "\n";
+    }
+  }
+  write_text_atomic((folder / kMarkerFile).string(), text);
+}
+
+// Entries of `folder` the marker does not list, sorted.
+std::vector<std::string> unlisted(const fs::path& folder, const Marker& m) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name != kMarkerFile && !m.files.count(name)) names.push_back(name);
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// Throws unless `output` may be replaced: absent, an empty folder, or a folder an earlier run
+// wrote (its marker complete and listing every entry in it).
+void check_replaceable(const fs::path& output, const std::string& where) {
+  struct stat st {};
+  if (::lstat(output.c_str(), &st) != 0) return;
+  if (S_ISLNK(st.st_mode)) {
+    throw Error(where + ": output '" + output.string() +
+                "' is a symbolic link; dynid run replaces its output folder and does not follow "
+                "links: give the folder's real path");
+  }
+  if (!S_ISDIR(st.st_mode)) {
+    throw Error(where + ": output '" + output.string() +
+                "' exists and is not a folder; choose another output");
+  }
+  std::error_code ec;
+  if (fs::is_empty(output, ec) && !ec) return;
+  const Marker m = read_marker(output);
+  if (!m.valid || !m.complete) {
+    throw Error(where + ": output folder " + output.string() +
+                " exists and was not written by dynid run (no valid " + kMarkerFile +
+                " in it); choose another output or remove it");
+  }
+  const std::vector<std::string> extra = unlisted(output, m);
+  if (!extra.empty()) {
+    const std::vector<std::string> shown(extra.begin(),
+                                         extra.begin() + std::min<std::size_t>(extra.size(), 3));
+    throw Error(where + ": output folder " + output.string() + " holds " + join(shown) +
+                (extra.size() > 3 ? " and " + std::to_string(extra.size() - 3) + " more" : "") +
+                ", which dynid run did not write; move " + (extra.size() > 1 ? "them" : "it") +
+                " out of the folder or choose another output");
+  }
+}
+
+bool process_alive(long pid) {
+  if (pid <= 0 || pid == static_cast<long>(::getpid())) return false;
+  return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM;
+}
+
+// Creates <output>.partial for this run, after removing one an earlier run left (its marker
+// valid, its writer gone). A folder of that name dynid run did not create is refused.
+void prepare_partial(const fs::path& partial, const fs::path& project, const std::string& where) {
+  std::error_code ec;
+  fs::create_directories(partial.parent_path(), ec);
+  struct stat st {};
+  if (::lstat(partial.c_str(), &st) == 0) {
+    const std::string refused = where + ": " + partial.string() +
+                                " exists and was not created by dynid run; move it away or "
+                                "choose another output";
+    if (!S_ISDIR(st.st_mode)) throw Error(refused);
+    if (!fs::is_empty(partial, ec) || ec) {
+      const Marker m = read_marker(partial);
+      if (!m.valid) throw Error(refused);
+      if (!m.complete && process_alive(m.pid)) {
+        throw Error(where + ": " + partial.string() +
+                    " is being written by another dynid run (pid " + std::to_string(m.pid) +
+                    "); wait for it to finish or choose another output");
+      }
+    }
+    fs::remove_all(partial, ec);
+    if (ec) {
+      throw Error(where + ": cannot remove the leftover " + partial.string() + " (" + ec.message() +
+                  "); remove it by hand");
+    }
+  }
+  if (::mkdir(partial.c_str(), 0777) != 0) {
+    throw Error(where + ": cannot create " + partial.string() + " (" + std::strerror(errno) +
+                "); check that the folder of the output exists and is writable");
+  }
+  write_marker(partial, project, false);
+}
+
+// True when `inner` is `outer` or lies inside it (both canonical).
+bool within(const fs::path& inner, const fs::path& outer) {
+  auto i = inner.begin();
+  for (auto o = outer.begin(); o != outer.end(); ++o, ++i) {
+    if (o->empty()) continue;  // a trailing separator
+    if (i == inner.end() || *i != *o) return false;
+  }
+  return true;
+}
+
+fs::path canonical_or_normal(const fs::path& p) {
+  std::error_code ec;
+  fs::path c = fs::weakly_canonical(p, ec);
+  return ec ? p.lexically_normal() : c;
+}
+
+// ---- Recorded runs ------------------------------------------------------------------------------
+
 // A recorded run given by the user: a path, or {join: [files], columns: [names]} for runs logged
 // as several files side by side (one row per sample in each, e.g. positions and currents).
+// Joined files are read from under the project folder only, regular files, at most
+// kMaxCsvFileBytes together (the joined run is read back with that cap), and the result is
+// written as run<index+1>.csv in the working directory (the output folder being built).
 std::string data_file(const YAML::Node& item, const std::string& where, const fs::path& project_dir,
                       int index) {
   const auto existing = [&](const std::string& name) {
@@ -90,11 +309,19 @@ std::string data_file(const YAML::Node& item, const std::string& where, const fs
   }
   std::vector<std::string> files, columns;
   for (const auto& kv : item) {
-    const std::string key = kv.first.as<std::string>();
+    const std::string key = kv.first.Scalar();
     if (key == "join" && kv.second.IsSequence()) {
-      for (const auto& f : kv.second) files.push_back(existing(f.as<std::string>()));
+      for (const auto& f : kv.second) {
+        if (!f.IsScalar() || f.Scalar().empty()) {
+          throw UsageError(where + ": join takes a list of file names");
+        }
+        files.push_back(f.Scalar());
+      }
     } else if (key == "columns" && kv.second.IsSequence()) {
-      for (const auto& c : kv.second) columns.push_back(c.as<std::string>());
+      for (const auto& c : kv.second) {
+        if (!c.IsScalar()) throw UsageError(where + ": columns takes a list of names");
+        columns.push_back(c.Scalar());
+      }
     } else {
       throw UsageError(where + ": unknown key '" + key +
                        "' in a data entry (or not a list); valid keys are join, columns");
@@ -103,13 +330,35 @@ std::string data_file(const YAML::Node& item, const std::string& where, const fs
   if (files.empty() || columns.empty()) {
     throw UsageError(where + ": a joined data entry needs join: [files] and columns: [names]");
   }
-  // The files' own header rows are replaced by `columns`; the rows are pasted side by side.
-  std::vector<std::ifstream> in;
-  size_t fields = 0;
+  // Under the project folder as written: no absolute path, no way up with "..".
   for (const auto& f : files) {
-    in.emplace_back(f);
-    std::string header;
-    if (!std::getline(in.back(), header)) throw Error(where + ": data file '" + f + "' is empty");
+    const fs::path normal = fs::path(f).lexically_normal();
+    if (fs::path(f).is_absolute() || (!normal.empty() && *normal.begin() == "..")) {
+      throw UsageError(where + ": joined file '" + f +
+                       "' is outside the project folder; joined files are read from under the "
+                       "folder of the project file only: put the file (or a link to it) there");
+    }
+  }
+  // The files' own header rows are replaced by `columns`; the rows are pasted side by side.
+  std::vector<std::string> texts;
+  std::size_t total = 0, fields = 0;
+  for (const auto& f : files) {
+    const fs::path p = (project_dir / f).lexically_normal();
+    std::error_code ec;
+    if (!fs::exists(p, ec)) {
+      throw Error(where + ": data file '" + f + "' not found (looked for " + p.string() +
+                  "); give the path relative to the project file");
+    }
+    texts.push_back(read_regular_file(p, kMaxCsvFileBytes, where + ": joined file"));
+    total += texts.back().size();
+    if (total > kMaxCsvFileBytes) {
+      throw Error(where + ": the joined files are larger than " +
+                  std::to_string(kMaxCsvFileBytes >> 20) +
+                  " MiB together, the limit for a run read into memory; join shorter files");
+    }
+    const std::string& t = texts.back();
+    const std::string header = t.substr(0, t.find('\n'));
+    if (t.empty()) throw Error(where + ": data file '" + f + "' is empty");
     fields += std::count(header.begin(), header.end(), ',') + 1;
   }
   if (fields != columns.size()) {
@@ -118,39 +367,78 @@ std::string data_file(const YAML::Node& item, const std::string& where, const fs
                      "; give one name per column");
   }
   const std::string name = "run" + std::to_string(index + 1) + ".csv";
-  std::ofstream out(name);
-  out << join(columns, ",") << '\n';
-  for (long row = 2;; ++row) {
-    std::string line, merged;
-    int ended = 0;
-    for (size_t i = 0; i < in.size(); ++i) {
-      if (!std::getline(in[i], line)) {
-        ++ended;
-        continue;
-      }
+  write_file_atomic(name, [&](std::ostream& out) {
+    out << join(columns, ",") << '\n';
+    std::vector<std::size_t> at(texts.size(), 0);
+    for (auto& a : at) a = std::string::npos;  // before the header
+    const auto next_line = [&](std::size_t i, std::string& line) {
+      const std::string& t = texts[i];
+      std::size_t start = at[i] == std::string::npos ? 0 : at[i];
+      if (start >= t.size()) return false;
+      std::size_t end = t.find('\n', start);
+      if (end == std::string::npos) end = t.size();
+      line.assign(t, start, end - start);
+      at[i] = end + 1;
       if (!line.empty() && line.back() == '\r') line.pop_back();
-      merged += (i ? "," : "") + line;
+      return true;
+    };
+    std::string line, merged;
+    for (std::size_t i = 0; i < texts.size(); ++i) next_line(i, line);  // the header rows
+    for (long row = 2;; ++row) {
+      merged.clear();
+      std::size_t ended = 0;
+      for (std::size_t i = 0; i < texts.size(); ++i) {
+        if (!next_line(i, line)) {
+          ++ended;
+          continue;
+        }
+        merged += (i ? "," : "") + line;
+      }
+      if (ended == texts.size()) break;
+      if (ended) {
+        throw Error(where + ": the joined files end at different rows (one ends at row " +
+                    std::to_string(row - 1) + " of " + join(files) + "); give files of one run");
+      }
+      if (merged.size() > kMaxCsvLineBytes) {
+        throw Error(where + ": row " + std::to_string(row) +
+                    " of the joined files is longer than " +
+                    std::to_string(kMaxCsvLineBytes >> 20) + " MiB; check that they are CSV files");
+      }
+      out << merged << '\n';
     }
-    if (ended == static_cast<int>(in.size())) break;
-    if (ended) {
-      throw Error(where + ": the joined files end at different rows (one ends at row " +
-                  std::to_string(row - 1) + " of " + join(files) + "); give files of one run");
-    }
-    out << merged << '\n';
-  }
-  if (!out) throw Error(where + ": could not write " + name + " in the output folder");
+  });
   return name;
 }
 
-// The stage's keys as command-line words, checked against the command's registered flags.
+// ---- Stages -------------------------------------------------------------------------------------
+
+// A file a stage key names for its command to write (`history: rls.csv`): a plain file name, so
+// that it lands in the output folder and nowhere else.
+void check_output_name(const std::string& name, const std::string& key, const std::string& where) {
+  const fs::path p(name);
+  const bool control = std::any_of(name.begin(), name.end(), [](char c) {
+    return static_cast<unsigned char>(c) < 0x20 || c == 0x7F;
+  });
+  if (name.empty() || p.is_absolute() || name.find('/') != std::string::npos || name == "." ||
+      name == ".." || control) {
+    throw UsageError(where + ": '" + key + ": " + name +
+                     "' must be a file name in the output folder (no folder, no .., not absolute); "
+                     "give e.g. " +
+                     key + ": " + key + (key == "report" ? ".html" : ".csv"));
+  }
+}
+
+// The stage's keys as command-line words, checked against the command's registered flags. The
+// file names of output keys are appended to `written` as {key, name}.
 std::vector<std::string> stage_flags(const YAML::Node& node, const StageWiring& stage,
                                      const std::vector<CommandFlag>& flags,
-                                     const fs::path& project_dir, const std::string& where) {
+                                     const fs::path& project_dir, const std::string& where,
+                                     std::vector<std::pair<std::string, std::string>>& written) {
   std::vector<std::string> valid;
   for (const auto& f : flags) {
-    const bool written = std::any_of(stage.outputs.begin(), stage.outputs.end(),
-                                     [&](const auto& o) { return o.flag == f.name; });
-    if (!written && f.name != "help") valid.push_back(f.name);
+    const bool set_by_runner = std::any_of(stage.outputs.begin(), stage.outputs.end(),
+                                           [&](const auto& o) { return o.flag == f.name; });
+    if (!set_by_runner && f.name != "help") valid.push_back(f.name);
   }
   if (!node.IsNull() && !node.IsMap()) {
     throw UsageError(where + ": give a mapping of " + stage.command + " flags (e.g. " +
@@ -159,7 +447,7 @@ std::vector<std::string> stage_flags(const YAML::Node& node, const StageWiring& 
   std::vector<std::string> args;
   if (node.IsNull()) return args;
   for (const auto& kv : node) {
-    const std::string key = kv.first.as<std::string>();
+    const std::string key = kv.first.Scalar();
     const auto output = std::find_if(stage.outputs.begin(), stage.outputs.end(),
                                      [&](const auto& o) { return o.flag == key; });
     if (output != stage.outputs.end()) {
@@ -173,7 +461,13 @@ std::vector<std::string> stage_flags(const YAML::Node& node, const StageWiring& 
                        " (the flags of dynid " + stage.command + " without --)");
     }
     const YAML::Node& v = kv.second;
-    if (!flag->takes_value) {
+    if (flag->writes) {
+      // Never resolved beside the project file: an output goes into the output folder.
+      if (!v.IsScalar()) throw UsageError(where + ": '" + key + "' takes one file name");
+      check_output_name(v.Scalar(), key, where);
+      written.emplace_back(key, v.Scalar());
+      args.insert(args.end(), {"--" + key, v.Scalar()});
+    } else if (!flag->takes_value) {
       bool on = false;
       if (!v.IsScalar() || !YAML::convert<bool>::decode(v, on)) {
         throw UsageError(where + ": '" + key + "' is a switch; give true or false");
@@ -228,9 +522,10 @@ ProjectResult run_project(const ProjectOptions& options, const CommandTable& tab
     throw Error("project file '" + options.project_file + "' not found; give a YAML project file");
   }
   const fs::path project_dir = project.parent_path();
+  const std::string project_text = read_regular_file(project, kMaxProjectFileBytes, "project file");
   YAML::Node root;
   try {
-    root = YAML::LoadFile(project.string());
+    root = YAML::Load(project_text);
   } catch (const YAML::Exception& e) {
     throw Error(where + ": not valid YAML (" + e.what() + "); fix the file");
   }
@@ -248,7 +543,7 @@ ProjectResult run_project(const ProjectOptions& options, const CommandTable& tab
     }
   }
   for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
+    const std::string key = kv.first.Scalar();
     if (std::find(valid.begin(), valid.end(), key) == valid.end()) {
       throw UsageError(where + ": unknown key '" + key + "'; valid keys are " + join(valid));
     }
@@ -266,6 +561,7 @@ ProjectResult run_project(const ProjectOptions& options, const CommandTable& tab
   const std::string robot = text(kRobotKey);
   if (robot.empty())
     throw UsageError(where + ": 'robot' is missing; give a built-in name or a model");
+  const std::string output_text = options.output.empty() ? text(kOutputKey) : options.output;
   fs::path output =
       options.output.empty() ? fs::path(text(kOutputKey)) : fs::absolute(options.output);
   if (output.empty()) {
@@ -274,46 +570,93 @@ ProjectResult run_project(const ProjectOptions& options, const CommandTable& tab
   if (output.is_relative()) output = project_dir / output;
   output = output.lexically_normal();
   if (output.filename().empty()) output = output.parent_path();
+  // The output folder is replaced as a whole: never the project's own folder or one holding it.
+  const fs::path canonical_output = canonical_or_normal(output),
+                 canonical_project_dir = canonical_or_normal(project_dir);
+  if (within(canonical_project_dir, canonical_output)) {
+    throw UsageError(where + ": output '" + output_text + "' is " +
+                     (canonical_output == canonical_project_dir ? "the folder of the project file"
+                                                                : "a folder holding the project") +
+                     "; dynid run replaces its output folder as a whole, so give a new folder, "
+                     "e.g. output: study");
+  }
 
   // Check every stage's keys before anything runs.
   std::vector<std::pair<const StageWiring*, std::vector<std::string>>> plan;
+  std::vector<std::pair<std::string, std::string>> written;  // {stage: key, file name}
   for (const auto& stage : project_stages()) {
     if (!root[stage.command]) continue;
+    std::vector<std::pair<std::string, std::string>> keys;
     plan.emplace_back(&stage, stage_flags(root[stage.command], stage, flags[stage.command],
-                                          project_dir, where + ": " + stage.command));
+                                          project_dir, where + ": " + stage.command, keys));
+    for (auto& k : keys) written.emplace_back(stage.command + ": " + k.first, k.second);
   }
   if (plan.empty() && !root[kDataKey]) {
     throw UsageError(where + ": no stage to run; add some of " +
                      join(std::vector<std::string>(valid.begin() + 3, valid.end())));
   }
 
-  // A folder is replaced only when a previous `dynid run` wrote it.
-  if (fs::exists(output, ec) && !fs::is_empty(output, ec) &&
-      !fs::exists(output / kCommandsFile, ec)) {
-    throw Error(where + ": output folder " + output.string() +
-                " exists and was not written by dynid run; choose another output or remove it");
+  // The names the runner writes into the folder; a stage's own output keys must not take them.
+  std::map<std::string, std::string> taken = {
+      {kMarkerFile, "dynid run's marker"},
+      {kCommandsFile, "the command lines"},
+      {project.filename().string(), "the copy of the project file"},
+      {"data.txt", "what reading the data printed"},
+  };
+  std::vector<YAML::Node> data_items;
+  if (const YAML::Node data = root[kDataKey]) {
+    if (data.IsSequence()) {
+      for (const auto& item : data) data_items.push_back(item);
+    } else {
+      data_items.push_back(data);
+    }
   }
+  for (size_t i = 0; i < data_items.size(); ++i) {
+    if (data_items[i].IsMap()) taken["run" + std::to_string(i + 1) + ".csv"] = "a joined data run";
+  }
+  for (const auto& [stage, args] : plan) {
+    if (stage->command + ".txt" == project.filename()) {
+      throw UsageError(where + ": the project file is named like the log of the " + stage->command +
+                       " stage; rename the project file (e.g. study.yaml)");
+    }
+    taken.emplace(stage->command + ".txt", "what " + stage->command + " printed");
+    for (const auto& out : stage->outputs) {
+      if (out.file == project.filename()) {
+        throw UsageError(where + ": the project file is named like " + out.file + ", which the " +
+                         stage->command +
+                         " stage writes; rename the project file (e.g. study.yaml)");
+      }
+      taken.emplace(out.file, stage->command + "'s " + out.flag);
+      if (stage->command == "simulate" && out.flag == "out") {
+        taken.emplace(gains_file_for_run(out.file), "simulate's gains");
+      }
+    }
+  }
+  for (const auto& [key, name] : written) {
+    const auto clash = taken.find(name);
+    if (clash != taken.end()) {
+      throw UsageError(where + ": " + key + ": '" + name + "' is already " + clash->second +
+                       " in the output folder; give another file name");
+    }
+    taken.emplace(name, key);
+  }
+
+  // A folder is replaced only when a previous `dynid run` wrote it.
+  check_replaceable(output, where);
   fs::path partial = output;
   partial += ".partial";
-  fs::remove_all(partial);
-  fs::create_directories(partial);
+  prepare_partial(partial, project, where);
 
   ProjectResult result;
   result.output_dir = output.string();
   try {
     std::map<std::string, std::vector<std::string>> artefacts;
     artefacts["robot"] = {resolve(robot, project_dir)};
-    if (const YAML::Node data = root[kDataKey]) {
-      std::vector<YAML::Node> items;
-      if (data.IsSequence()) {
-        for (const auto& item : data) items.push_back(item);
-      } else {
-        items.push_back(data);
-      }
+    if (!data_items.empty()) {
       in_folder(partial, "data.txt", [&] {
-        for (size_t i = 0; i < items.size(); ++i) {
+        for (size_t i = 0; i < data_items.size(); ++i) {
           artefacts["run"].push_back(
-              data_file(items[i], where + ": data", project_dir, static_cast<int>(i)));
+              data_file(data_items[i], where + ": data", project_dir, static_cast<int>(i)));
         }
       });
     }
@@ -357,22 +700,35 @@ ProjectResult run_project(const ProjectOptions& options, const CommandTable& tab
       }
       result.commands.push_back(args);
     }
-    fs::copy_file(project, partial / project.filename(), fs::copy_options::overwrite_existing);
-    std::ofstream commands(partial / kCommandsFile);
-    commands << "# written by dynid run " << project.filename().string()
-             << "; each line ran in this folder\n";
+    write_text_atomic((partial / project.filename()).string(), project_text);
+    std::string commands = "# written by dynid run " + project.filename().string() +
+                           "; each line ran in this folder\n";
     for (const auto& c : result.commands) {
       std::string line = "dynid";
       for (const auto& w : c) line += " " + quoted(w);
-      commands << line << '\n';
+      commands += line + '\n';
     }
-    if (!commands) throw Error(where + ": could not write " + (partial / kCommandsFile).string());
+    write_text_atomic((partial / kCommandsFile).string(), commands);
+    write_marker(partial, project, true);
+    // Again now: files may have been put into the old folder while the stages ran.
+    check_replaceable(output, where);
   } catch (...) {
     fs::remove_all(partial, ec);
     throw;
   }
-  fs::remove_all(output);
-  fs::rename(partial, output);
+  // From here the complete study is kept in <output>.partial whatever fails.
+  if (fs::exists(output, ec)) {
+    fs::remove_all(output, ec);
+    if (ec) {
+      throw Error(where + ": cannot remove the earlier " + output.string() + " (" + ec.message() +
+                  "); the new study is in " + partial.string() + ": remove the old one by hand");
+    }
+  }
+  fs::rename(partial, output, ec);
+  if (ec) {
+    throw Error(where + ": cannot rename " + partial.string() + " to " + output.string() + " (" +
+                ec.message() + "); the study is complete in " + partial.string());
+  }
   return result;
 }
 

@@ -168,6 +168,23 @@ TEST_F(RunCli, FailingStageLeavesNoFolderAndAForeignFolderIsKept) {
   EXPECT_EQ(testing::slurp(work("o/notes.txt")), "mine");
 }
 
+// An excitation that cannot meet its limits stops the study there (it used to be written with
+// "constraints VIOLATED" and simulated): the error names the stage, the tightest constraint and
+// its flag, and no folder is left.
+TEST_F(RunCli, ExcitationThatViolatesItsLimitsStopsTheStudy) {
+  const std::string project =
+      write("p.yaml",
+            "output: o\nrobot: planar2\nexcite:\n  harmonics: 3\n  f0: 0.5\n  starts: 1\n"
+            "  max-evaluations: 100\n  max-time: 0\n  velocity-limit: 2.0\n"
+            "  acceleration-limit: 8.0\n  torque-limit: 0.5\nsimulate:\n  periods: 2\n");
+  const auto r = run("run " + project);
+  expect_error(r, 1, "p.yaml: excite: no excitation of 'planar2' found meets its constraints");
+  EXPECT_NE(r.err.find("torque q1"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--torque-limit"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("simulate"), std::string::npos) << r.err;
+  expect_nothing_written(1);
+}
+
 TEST_F(RunCli, Tx40ExampleProjectIdentifiesAndValidatesOnUnseenSeconds) {
   const fs::path project = fs::path(DYNID_SOURCE_DIR) / "examples/project/tx40.yaml";
   if (!fs::exists(fs::path(DYNID_SOURCE_DIR) / "examples/staubli-tx40/dataset/data")) {

@@ -147,9 +147,10 @@ constexpr double kOffset[3] = {0.8, -0.6, 0.5};  // current-measurement offset [
 
 struct ExampleUnion {
   IdentificationResult short_fo, short_seed1, long_seed1;
-  IdentificationResult joint1;  // the joint-1 run alone, short integrals
-  Eigen::VectorXd all;          // standard parameters of the full layout, coupling columns zero
-  Eigen::VectorXd all_seed1;    // the same without the Fo columns
+  IdentificationResult joint1;       // the joint-1 run alone, short integrals
+  IdentificationResult joint2_long;  // the joint-2 run alone, long integrals, seed 1's friction
+  Eigen::VectorXd all;        // standard parameters of the full layout, coupling columns zero
+  Eigen::VectorXd all_seed1;  // the same without the Fo columns
 };
 
 Reference via_point_moves(const Eigen::MatrixXd& points, double ts) {
@@ -208,6 +209,7 @@ const ExampleUnion& example_union() {
     out.short_seed1 = identify(model, runs, io);
     io.integral.long_integrals = true;
     out.long_seed1 = identify(model, runs, io);
+    out.joint2_long = identify(model, runs[1], io);
     return out;
   }();
   return u;
@@ -216,18 +218,7 @@ const ExampleUnion& example_union() {
 // The truth of what a (possibly data-rank-deficient) result estimates: each kept base parameter
 // plus the data regrouping of the not-excited ones, from the model's own standard parameters.
 Eigen::VectorXd estimated_truth(const IdentificationResult& res, const Eigen::VectorXd& all) {
-  const Eigen::VectorXd base = res.base.reduce(all);
-  auto at = [&](const std::string& name) {
-    return base[std::find(res.base.names.begin(), res.base.names.end(), name) -
-                res.base.names.begin()];
-  };
-  Eigen::VectorXd truth(static_cast<Eigen::Index>(res.names.size()));
-  for (size_t i = 0; i < res.names.size(); ++i) {
-    truth[i] = at(res.names[i]);
-    for (size_t j = 0; j < res.not_excited.size(); ++j)
-      truth[i] += res.data_regrouping(i, j) * at(res.not_excited[j]);
-  }
-  return truth;
+  return estimated_base_values(res, res.base.reduce(all));
 }
 
 // Largest relative error of the joints' viscous and Coulomb estimates (their truths are not
@@ -274,6 +265,35 @@ TEST(IntegralIrp6Example, JointsHeldOnOneEncoderCountAreNotExcited) {
   }
   for (Eigen::Index i = 0; i < r.estimate.x.size(); ++i)
     EXPECT_LT(r.estimate.std_dev[i], 1e3) << r.names[i] << " = " << r.estimate.x[i];
+}
+
+// Joint 2 moves alone: motor 3 (q_m3 = q2 + q3, the IRp-6's parallelogram drive) turns with it,
+// u = q̇2, so its Coulomb work is Fc2's column exactly and the two are one parameter. They were
+// both kept (Fc2 26.9 ± 219, Fcm3 1.9 ± 219 with long integrals: the motor's column was the
+// unfiltered ∫|u| beside the joint's parallel-filtered one); now Fcm3 is regrouped into Fc2 and
+// named, and Fc2 estimates Fc2 + Fcm3 = 28.75 N·m (Fcm3 is 0 in the plant).
+TEST(IntegralIrp6Example, MotorTurningWithOneJointIsRegroupedIntoItsFriction) {
+  const IdentificationResult& r = example_union().joint2_long;
+  ASSERT_NE(std::find(r.not_excited.begin(), r.not_excited.end(), "Fcm3"), r.not_excited.end());
+  const auto fc2 = std::find(r.names.begin(), r.names.end(), "Fc2");
+  ASSERT_NE(fc2, r.names.end());
+  const auto i = fc2 - r.names.begin();
+  const auto j =
+      std::find(r.not_excited.begin(), r.not_excited.end(), "Fcm3") - r.not_excited.begin();
+  EXPECT_NEAR(r.data_regrouping(i, j), 1.0, 1e-6);
+  EXPECT_NE(r.expressions[static_cast<size_t>(i)].find("+ 1*Fcm3 (on these data)"),
+            std::string::npos)
+      << r.expressions[static_cast<size_t>(i)];
+  bool named = false;
+  for (const auto& w : r.warnings)
+    named |= w.rfind("Fcm3 is not excited: the data cannot tell it from Fc2", 0) == 0;
+  EXPECT_TRUE(named);
+  EXPECT_LT(r.estimate.std_dev[i], 0.1 * 28.75) << r.estimate.x[i];
+  EXPECT_NEAR(r.estimate.x[i], 28.75, 0.1 * 28.75);
+  // The union: joints 2 and 3 each move alone in one run, so Fcm3 = Fc2 + Fc3 on the union.
+  const IdentificationResult& all = example_union().long_seed1;
+  EXPECT_NE(std::find(all.not_excited.begin(), all.not_excited.end(), "Fcm3"),
+            all.not_excited.end());
 }
 
 // Seed 1's ranking, from its mechanism: an unmodelled constant torque offset b_j does the work

@@ -271,6 +271,44 @@ TEST(DataIdentifiability, TheBoundaryIsWhereTheStdReachesThePlausibleMagnitude) 
   }
 }
 
+// The columns an estimate lives on, by name and in the names' order.
+TEST(SelectNamedColumns, TakesTheNamedColumnsInTheirOrderAndRefusesOthers) {
+  std::mt19937 rng(5);
+  EquationBlock b;
+  b.W = estimation_testing::gaussian(6, 4, rng);
+  b.y = Eigen::VectorXd::LinSpaced(6, 1.0, 6.0);
+  b.columns = {"a", "b", "c", "d"};
+  const EquationBlock s = select_named_columns(b, {"d", "a"});
+  EXPECT_EQ(s.columns, (std::vector<std::string>{"d", "a"}));
+  ASSERT_EQ(s.W.cols(), 2);
+  EXPECT_EQ(s.W.col(0), b.W.col(3));
+  EXPECT_EQ(s.W.col(1), b.W.col(0));
+  EXPECT_EQ(s.y, b.y);
+  EXPECT_THROW(select_named_columns(b, {"a", "e"}), Error);
+}
+
+// What each estimate of a data-deficient result stands for: its own base value plus the data
+// regrouping of the ones not excited (the demo's truth column and the tests' truths).
+TEST(EstimatedBaseValues, KeptValuesPlusTheShareOfTheNotExcitedOnes) {
+  IdentificationResult r;
+  r.base.names = {"A", "B", "C"};
+  r.names = {"A", "C"};
+  r.not_excited = {"B"};
+  r.data_regrouping = (Eigen::MatrixXd(2, 1) << 2.0, 0.5).finished();
+  const Eigen::VectorXd v = estimated_base_values(r, Eigen::Vector3d(1.0, 10.0, 100.0));
+  ASSERT_EQ(v.size(), 2);
+  EXPECT_DOUBLE_EQ(v[0], 1.0 + 2.0 * 10.0);
+  EXPECT_DOUBLE_EQ(v[1], 100.0 + 0.5 * 10.0);
+  EXPECT_THROW(estimated_base_values(r, Eigen::Vector2d(1.0, 10.0)), Error);
+  r.data_regrouping.resize(3, 1);  // one row per estimate or it is an error
+  EXPECT_THROW(estimated_base_values(r, Eigen::Vector3d(1.0, 10.0, 100.0)), Error);
+  // Every parameter excited: the base values themselves, in the result's order.
+  IdentificationResult all;
+  all.base.names = {"A", "B"};
+  all.names = {"A", "B"};
+  EXPECT_EQ(estimated_base_values(all, Eigen::Vector2d(3.0, 4.0)), Eigen::Vector2d(3.0, 4.0));
+}
+
 TEST(EstimateBlock, OrdinaryLeastSquaresOfTheBlockAndItsGroupResiduals) {
   std::mt19937 rng(3);
   EquationBlock b;

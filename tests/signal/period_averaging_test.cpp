@@ -122,6 +122,44 @@ TEST(CheckPeriodRepeats, RightPeriodPassesWrongOneIsNamed) {
   EXPECT_FALSE(is_reference_channel("q1"));
 }
 
+// A held joint (examples/comau-s2's one-joint runs: q1 held while another joint follows its
+// reference) has a range that is its noise: its spread across periods is then ~15 % of that range
+// whatever the period, and said nothing about the period ("q1 spreads by 10.9 % of its range").
+// It passes silently; the same joint drifting by 30 σ over the run, or the moving joint averaged
+// with a wrong period, still warns.
+TEST(CheckPeriodRepeats, AHeldJointsNoiseIsNotASpreadButItsDriftIs) {
+  const int m = 3000;  // 6 periods of 1 s at 500 Hz
+  Eigen::VectorXd t(m);
+  Eigen::MatrixXd x(m, 3);
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> g(0.0, 1e-4);
+  for (int k = 0; k < m; ++k) {
+    t[k] = k / 500.0;
+    x(k, 0) = 0.2 + g(rng);                                    // q1 held
+    x(k, 1) = 0.8 * std::sin(2 * kPi * t[k]) + 1e-4 * g(rng);  // q2 moving
+    x(k, 2) = 0.2 + 3e-3 * k / (m - 1.0) + g(rng);             // q3 held, drifting by 30 σ
+  }
+  const std::vector<std::string> names = {"q1", "q2", "q3"};
+  const TimedPeriodAverage right = average_periods_in_time(t, x, 1.0);
+  // The case: the held joint spreads by more than 10 % of its range.
+  const auto held = x.col(0);
+  EXPECT_GT(right.channels[0].std / (held.maxCoeff() - held.minCoeff()), 0.1);
+  const auto w = check_period_repeats(right, x, names);
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_EQ(w[0].rfind("q3 spreads by", 0), 0u) << w[0];
+  // Encoder counts of 2.4e-5 rad (2^18 per revolution) on a held joint with 2e-5 rad of noise:
+  // its samples wander over a few counts.
+  Eigen::MatrixXd counts = x.leftCols(2);
+  const double step = 2 * kPi / 262144;
+  for (int k = 0; k < m; ++k) counts(k, 0) = step * std::round(x(k, 0) * 2e-1 / step);
+  EXPECT_TRUE(
+      check_period_repeats(average_periods_in_time(t, counts, 1.0), counts, {"q1", "q2"}).empty());
+  const auto wrong = check_period_repeats(average_periods_in_time(t, x.leftCols(2), 0.7),
+                                          x.leftCols(2), {"q1", "q2"});
+  ASSERT_EQ(wrong.size(), 1u);
+  EXPECT_EQ(wrong[0].rfind("q2 spreads by", 0), 0u) << wrong[0];
+}
+
 TEST(PeriodErrors, Messages) {
   const Eigen::MatrixXd x = Eigen::MatrixXd::Random(10, 2);
   expect_message([&] { average_periods(x, 0); },

@@ -77,9 +77,17 @@ struct ExcitationOptions {
 /// Worst margin of one constraint group over all samples: limit − value in the group's unit,
 /// ≥ 0 when it holds at every sample.
 struct ConstraintMargin {
-  std::string name;     ///< e.g. "position q3", "velocity q1", "torque q2", "workspace z"
+  std::string name;     ///< e.g. "position max q3", "velocity q1", "torque q2", "workspace z_min"
   double margin = 0.0;  ///< worst (smallest) margin; negative = violated [rad, rad/s, N·m, m...]
   double time = 0.0;    ///< time of the worst sample [s]
+  /// The limit as given (q_max, q_min, dq_max, ddq_max, tau_max, z_min, a box face) and the worst
+  /// value the trajectory reaches against it (max q, min q, max |dq|, ..., min z), in `unit`.
+  double limit = 0.0, reached = 0.0;
+  std::string unit;  ///< rad, m, rad/s, m/s, rad/s², m/s², N·m, N
+  /// margin over the constraint's own size (the position range; the velocity, acceleration or
+  /// torque limit; 0.1 m for the workspace): −0.2 is a violation by 20 % of it. Compares
+  /// constraints of different units (tightest_constraint).
+  double relative = 0.0;
 };
 
 /// Outcome of the excitation design.
@@ -109,6 +117,10 @@ struct ExcitationResult {
 /// a feasible point, the least-violating point is returned with constraints_satisfied = false
 /// (a numerical outcome, reported, not thrown).
 ExcitationResult optimize_excitation(const Model& model, const ExcitationOptions& options = {});
+
+/// The constraint closest to violation, or most violated: the smallest ConstraintMargin::relative
+/// of r.margins (a NaN one first: not met); nullptr when there is none.
+const ConstraintMargin* tightest_constraint(const ExcitationResult& r);
 
 /// Evaluation of a given trajectory under the options' criterion and constraints (the check that
 /// optimize_excitation runs at the end): criterion values on `samples_per_period` samples of one

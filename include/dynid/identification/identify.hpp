@@ -113,6 +113,15 @@ struct IdentificationResult {
   std::vector<ClosedLoopReport> closed_loop;
 };
 
+/// What a result's estimates stand for, given a value of every base parameter (base_values, in
+/// result.base.names order, e.g. the true base parameters of a simulation): per name of
+/// result.names, θ_b[name] + Σ_j data_regrouping(i, j)·θ_b[not_excited[j]]. With every base
+/// parameter excited that is θ_b itself; with some not excited it is the truth each kept estimate
+/// is to be compared with. Throws dynid::Error when base_values does not have one value per base
+/// parameter or the result's names, not_excited and data_regrouping do not match.
+Eigen::VectorXd estimated_base_values(const IdentificationResult& result,
+                                      const Eigen::VectorXd& base_values);
+
 /// Identifies the base parameters of `model` from a joint-side record: preprocess, stack the
 /// regressor (tau = Y·theta, seed 1 eq. 5 / seed 2 eq. 9), keep the base columns (Gautier–Khalil),
 /// estimate by OLS, Gautier's WLS or U-D RLS (seed 1 eqs. 36–37), and report statistics.

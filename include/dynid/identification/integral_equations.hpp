@@ -26,7 +26,11 @@ inline constexpr int kAutoIntervalSteps = 2;
 /// (exact when q is a cubic over the step), except that when `processed` carries the filtered
 /// moving indicators p_j, n_j (ProcessedRecord::moving_positive/negative) the Coulomb columns are
 /// ∫ q̇_j·(p_j − n_j) (asymmetric ∫ q̇_j·p_j, −∫ q̇_j·n_j) by options.rule: the Coulomb part of
-/// the filtered power (parallel filtering). No acceleration is used.
+/// the filtered power (parallel filtering); a coupled motor whose combination has a single joint
+/// j with a velocity that is not identically zero on the run (the others held) then has the Fcm
+/// column |n_kj| times that joint's ∫ q̇_j·(p_j − n_j), exactly the joint's Coulomb column up to
+/// the factor, as u = n_kj·q̇_j (so the data-identifiability stage regroups the two). No
+/// acceleration is used.
 /// Units: y [J], columns [J per parameter unit] (times the row weight of options.weighting).
 /// Block: ⌊(m − 1)/steps⌋ rows (m samples, `steps` per interval) × the named columns; group 0 =
 /// "energy" for every row, sample = interval index, t = interval end [s]. Throws

@@ -104,6 +104,13 @@ DataIdentifiability data_identifiability(const EquationBlock& block,
 /// The block restricted to `columns` (in that order).
 EquationBlock select_columns(const EquationBlock& block, const std::vector<int>& columns);
 
+/// The block restricted to the columns named `names` (in that order): the columns an estimate
+/// lives on, e.g. IdentificationResult::names (the data-identifiable base parameters, without the
+/// not_excited ones) of a block over all base parameters. Throws dynid::Error naming the first
+/// name that is not a column of the block.
+EquationBlock select_named_columns(const EquationBlock& block,
+                                   const std::vector<std::string>& names);
+
 /// Options of estimate_block (Ceres style).
 struct BlockEstimationOptions {
   IdentificationEstimator estimator = IdentificationEstimator::kOls;  ///< OLS, WLS or U-D RLS

@@ -11,7 +11,8 @@
 namespace dynid {
 
 /// `dynid excite --json`: `criterion`, `value`, `condition_number`, `log_det`,
-/// `constraints_satisfied`, `margins` (name, margin, time), `coefficients` (f0, a, b, q0),
+/// `constraints_satisfied`, `margins` (name, margin, time, limit, reached, unit, relative),
+/// `coefficients` (f0, a, b, q0),
 /// `base_parameters`, `evaluations`, `seconds`, `version`.
 nlohmann::json excitation_to_json(const ExcitationResult& result);
 

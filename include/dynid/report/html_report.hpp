@@ -89,8 +89,11 @@ nlohmann::json rls_history_plot_json(const IdentificationResult& r,
 /// of the first run, its end `t` [s], the `measured` work ∫τᵀq̇ dt [J] and the integral model's
 /// `predicted` (h(t_b) − h(t_a))·θ + friction work = W_b·θ̂_b [J], unweighted (integral_equations()
 /// with options.integral but IntegralWeighting::kNone, on result.processed), at most max_points
-/// intervals (every k-th); `decimated_every` k. Null when the estimate has a non-finite value (a
-/// parameter the data do not determine). Throws as integral_equations().
+/// intervals (every k-th); `decimated_every` k. W_b has exactly the columns result.names: with
+/// parameters not excited (result.not_excited) the kept estimates hold their share on these data
+/// (result.data_regrouping), so the kept columns alone predict the work. Null when the estimate
+/// has a non-finite value. Throws dynid::Error when the estimate and result.names differ in size
+/// or a name is not a base column, and as integral_equations().
 nlohmann::json energy_plot_json(const Model& model, const IdentificationResult& result,
                                 const IdentifyOptions& options,
                                 const PredictionPlotOptions& plot_options = {});

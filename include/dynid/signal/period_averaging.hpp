@@ -127,7 +127,9 @@ bool is_reference_channel(const std::string& name);
 /// ChannelNoise::std) above 1 % of its range means the period is wrong; the error names the
 /// channel, the spread and the period detect_period() finds in it. A position channel (q<J>)
 /// spreading by more than 10 % of its range gives a returned warning (noise, drift or a wrong
-/// period: without a reference the run cannot tell which).
+/// period: without a reference the run cannot tell which), unless its whole range is noise: a
+/// held joint, range ≤ 12 σ_d with σ_d = RMS(second differences)/√6 its sample-to-sample noise
+/// (a constant repeats with any period; its spread is then its noise, a large part of its range).
 /// Throws dynid::Error for a reference channel that does not repeat, or sizes that do not match.
 std::vector<std::string> check_period_repeats(const TimedPeriodAverage& a,
                                               const Eigen::Ref<const Eigen::MatrixXd>& x,

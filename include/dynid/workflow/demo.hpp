@@ -26,7 +26,9 @@ struct DemoOptions {
 /// What the demo found: identified vs true base parameters and the validation errors.
 struct DemoResult {
   IdentificationResult identification;
-  Eigen::VectorXd truth;  ///< true base parameters (model values reduced)
+  /// True value of each identified parameter (identification.names): the model's values reduced
+  /// to base parameters, plus the data regrouping of any not excited (estimated_base_values).
+  Eigen::VectorXd truth;
   ExcitationResult excitation;
   ValidationResult validation;  ///< torque prediction on a trapezoidal move
   std::string table;            ///< the printed summary

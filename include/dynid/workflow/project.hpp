@@ -16,6 +16,7 @@ struct CommandFlag {
   std::string name;         ///< long name without "--", e.g. "estimator"
   bool takes_value = true;  ///< false for a switch (`--physical`)
   bool repeatable = false;  ///< a list is given as the flag repeated (`--data a --data b`)
+  bool writes = false;      ///< names a file the command writes (`--report`, `--history`)
 };
 
 /// The command line the project runner drives. The project keys are checked against `flags`, so
