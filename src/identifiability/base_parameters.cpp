@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <numeric>
 #include <random>
@@ -68,6 +69,34 @@ double random_position(const Joint& joint, std::mt19937& rng) {
     hi = span;
   }
   return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
+
+// Joint value at fraction u ∈ [0, 1) of the limits, or of [−π, π] / [−0.5, 0.5] m.
+double position_in_range(const Joint& joint, double u) {
+  double lo = joint.limits.lower, hi = joint.limits.upper;
+  if (!std::isfinite(lo) || !std::isfinite(hi) || hi - lo < 1e-6) {
+    const double span = joint.type == JointType::kRevolute ? M_PI : 0.5;
+    lo = -span;
+    hi = span;
+  }
+  return lo + (hi - lo) * u;
+}
+
+// Uniform in [0, 1) from (seed, state, joint, which) by splitmix64 mixing: the tree algorithm's
+// state of joint j does not depend on how many joints there are, so the first links of a chain
+// get the same column scales (and threshold pivots) whatever the chain's length.
+double hashed_unit(unsigned seed, int state, int joint, int which) {
+  std::uint64_t x = (static_cast<std::uint64_t>(seed) << 32) ^
+                    (static_cast<std::uint64_t>(state) * 0x9E3779B97F4A7C15ull) ^
+                    (static_cast<std::uint64_t>(joint) * 0xD1B54A32D192ED03ull) ^
+                    (static_cast<std::uint64_t>(which) * 0x94D049BB133111EBull);
+  for (int round = 0; round < 2; ++round) {
+    x += 0x9E3779B97F4A7C15ull;
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+    x ^= x >> 31;
+  }
+  return static_cast<double>(x >> 11) * 0x1.0p-53;
 }
 
 Eigen::MatrixXd sample_regressor(const Model& model, const BaseParameterOptions& options,
@@ -158,6 +187,124 @@ void describe(BaseParameters& out, const std::vector<std::string>& names,
   }
 }
 
+// Threshold pivoting of the regrouping (docs/methods/model.md, "Well-conditioned base columns").
+// Gautier's rule makes the last column of each null vector dependent, whatever its weight there.
+// When a joint axis is nearly, not exactly, along a frame axis that weight is small (about the
+// tilt squared): the dependent column is a large multiple of the link's base columns (K̃ ≈ 80 on
+// arm6_odd) and those base columns are nearly dependent on every trajectory (scaled condition
+// number 5e7 on random states, compounding along the chain). Per link, in units of columns scaled
+// by `scale`: the block K̃ = K_d restricted to the link's base rows and dependent columns (exchanges
+// inside a link change no other link's block); a dependent column d with weight
+// 1/√(1 + Σ_b K̃(b,d)²) below `threshold` trades places with the link's base column b of highest
+// index among those with at least half the largest |K̃(·,d)|, if |K̃(b,d)| > 1: a Gauss–Jordan
+// exchange, which multiplies the volume of the base columns by |K̃(b,d)| > 1, so it ends. Returns
+// true when some link changes, with `label` (column → position) ordering each changed link's
+// columns as [its new base columns, its new dependent columns, its zero columns], every other
+// column in place: Gautier's rule in that order gives the new split (the greedy sweep keeps each
+// link's base columns first; a link's dependencies involve only it and its ancestors), with an
+// exact K_d. Only the link parameters are exchanged.
+bool threshold_pivots(const BaseParameters& g, const Eigen::VectorXd& scale, int n,
+                      double threshold, std::vector<int>& label) {
+  const auto p = static_cast<int>(g.layout_names.size());
+  label.resize(static_cast<std::size_t>(p));
+  std::iota(label.begin(), label.end(), 0);
+  if (!(threshold > 0.0) || g.dependent.empty()) return false;
+  const double limit = 1.0 / (threshold * threshold) - 1.0;  // weak when Σ K̃² exceeds it
+  std::vector<int> row(static_cast<std::size_t>(p), -1), col(static_cast<std::size_t>(p), -1);
+  for (std::size_t i = 0; i < g.base.size(); ++i) row[g.base[i]] = static_cast<int>(i);
+  for (std::size_t j = 0; j < g.dependent.size(); ++j) col[g.dependent[j]] = static_cast<int>(j);
+  bool changed = false;
+  for (int k = 0; k < n && kLinkParams * (k + 1) <= p; ++k) {
+    std::vector<int> B, D, Z;
+    for (int c = kLinkParams * k; c < kLinkParams * (k + 1); ++c) {
+      (row[c] >= 0 ? B : col[c] >= 0 ? D : Z).push_back(c);
+    }
+    if (B.empty() || D.empty()) continue;
+    bool usable = true;
+    for (int c : B) usable = usable && scale[c] > 0.0 && std::isfinite(scale[c]);
+    for (int c : D) usable = usable && scale[c] > 0.0 && std::isfinite(scale[c]);
+    if (!usable) continue;
+    const auto nb = static_cast<Eigen::Index>(B.size()), nd = static_cast<Eigen::Index>(D.size());
+    Eigen::MatrixXd K(nb, nd);
+    for (Eigen::Index i = 0; i < nb; ++i)
+      for (Eigen::Index j = 0; j < nd; ++j)
+        K(i, j) = g.K_d(row[B[i]], col[D[j]]) * scale[B[i]] / scale[D[j]];
+    std::vector<char> settled(static_cast<std::size_t>(nd), 0);
+    bool link_changed = false;
+    for (int swaps = 0; swaps < 4 * kLinkParams * kLinkParams;) {
+      Eigen::Index j = -1;
+      for (Eigen::Index jj = 0; jj < nd; ++jj) {
+        if (!settled[jj] && K.col(jj).squaredNorm() > limit && (j < 0 || D[jj] > D[j])) j = jj;
+      }
+      if (j < 0) break;
+      // The exchange partner: of the base columns with nearly the largest coefficient (at least
+      // half of it), the one of highest index, as Gautier's rule prefers the last column.
+      const double largest = K.col(j).cwiseAbs().maxCoeff();
+      Eigen::Index i = -1;
+      for (Eigen::Index ii = 0; ii < nb; ++ii) {
+        if (std::abs(K(ii, j)) >= 0.5 * largest && (i < 0 || B[ii] > B[i])) i = ii;
+      }
+      if (i < 0 || !(std::abs(K(i, j)) > 1.0)) {
+        settled[j] = 1;  // no exchange inside the link would improve it
+        continue;
+      }
+      const double pivot = K(i, j);
+      for (Eigen::Index jj = 0; jj < nd; ++jj) {
+        if (jj == j) continue;
+        const double f = K(i, jj) / pivot;
+        for (Eigen::Index ii = 0; ii < nb; ++ii)
+          if (ii != i) K(ii, jj) -= f * K(ii, j);
+        K(i, jj) = f;
+        settled[jj] = 0;
+      }
+      for (Eigen::Index ii = 0; ii < nb; ++ii)
+        if (ii != i) K(ii, j) = -K(ii, j) / pivot;
+      K(i, j) = 1.0 / pivot;
+      std::swap(B[i], D[j]);
+      link_changed = true;
+      ++swaps;
+    }
+    if (!link_changed) continue;
+    changed = true;
+    std::sort(B.begin(), B.end());
+    std::sort(D.begin(), D.end());
+    int at = kLinkParams * k;
+    for (const auto* set : {&B, &D, &Z})
+      for (int c : *set) label[c] = at++;
+  }
+  return changed;
+}
+
+// A result computed on columns relabelled by `label` (column c at position label[c]), back in
+// column order: indices mapped, base and dependent sorted, K_d permuted alike.
+BaseParameters unlabel(BaseParameters in, const std::vector<int>& label,
+                       const std::vector<std::string>& names) {
+  std::vector<int> column(label.size());
+  for (std::size_t c = 0; c < label.size(); ++c) column[label[c]] = static_cast<int>(c);
+  auto map = [&](std::vector<int>& v) {
+    for (int& x : v) x = column[x];
+  };
+  map(in.base);
+  map(in.dependent);
+  map(in.unidentifiable);
+  std::sort(in.unidentifiable.begin(), in.unidentifiable.end());
+  std::vector<Eigen::Index> bo(in.base.size()), dpo(in.dependent.size());
+  std::iota(bo.begin(), bo.end(), Eigen::Index{0});
+  std::iota(dpo.begin(), dpo.end(), Eigen::Index{0});
+  std::sort(bo.begin(), bo.end(),
+            [&](Eigen::Index x, Eigen::Index y) { return in.base[x] < in.base[y]; });
+  std::sort(dpo.begin(), dpo.end(),
+            [&](Eigen::Index x, Eigen::Index y) { return in.dependent[x] < in.dependent[y]; });
+  BaseParameters out = in;
+  for (std::size_t i = 0; i < bo.size(); ++i) out.base[i] = in.base[bo[i]];
+  for (std::size_t j = 0; j < dpo.size(); ++j) out.dependent[j] = in.dependent[dpo[j]];
+  for (std::size_t i = 0; i < bo.size(); ++i)
+    for (std::size_t j = 0; j < dpo.size(); ++j)
+      out.K_d(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = in.K_d(bo[i], dpo[j]);
+  out.layout_names = names;
+  return out;
+}
+
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 
 // What the local systems need of one link at one sampled state: its body regressor (wrench about
@@ -216,75 +363,51 @@ Sparse axpy(const Sparse& a, double f, const Sparse& b) {
   return out;
 }
 
-// Numerical base parameters exploiting the tree (docs/methods/model.md, "Base parameters of large
-// trees"). A column combination x has no effect (W·x = 0) iff it moves no joint torque at any
-// state. The columns of link k are non-zero only in the rows of k and its ancestors, and every
-// ancestor row is the pairing of that ancestor's twist with the wrench the subtree exerts at k's
-// parent a, so the rows of the strict ancestors of a can be replaced, state by state, by an
-// orthonormal basis of their twists in frame a (≤ 6 rows) without changing which x have no effect.
-// The null space of each such local system over (link k, link a, their joint columns) is computed
-// by an SVD; their union spans the null space of W (regrouping moves parameters from a link to its
-// parent; checked against the dense sweep in tests/identifiability). The dependent columns are the
-// last non-zero indices of an echelon basis of that null space, exactly the columns the
-// left-to-right sweep finds dependent, and back-substitution gives K_d.
-BaseParameters tree_base_parameters(const Model& model, const BaseParameterOptions& options,
-                                    int samples, const std::vector<std::string>& names,
-                                    const Deadline& deadline) {
-  const int n = model.dof();
-  const int jc = options.layout.joint_columns();
-  const int p = options.layout.columns(n);
-  auto link_col = [](int j, int i) { return kLinkParams * j + i; };
-  auto joint_col = [&](int j, int c) { return kLinkParams * n + jc * j + c; };
-
-  // 1. Sampled states: per-link quantities only, O(n) per state.
-  std::vector<LinkSample> data(static_cast<std::size_t>(samples) * n);
-  {
-    Workspace ws(model);
-    std::mt19937 rng(options.seed);
-    std::uniform_real_distribution<double> u(-1.0, 1.0);
-    Eigen::VectorXd q(n), dq(n), ddq(n);
-    detail::WrenchBlocks b;
-    Eigen::Matrix<double, 6, Eigen::Dynamic> A(6, 7);
-    for (int s = 0; s < samples; ++s) {
+// Steps 1 and 2 of the tree algorithm: the sampled per-link data, the local system of each link,
+// and every layout column's norm in the system where it is "at home" (all its non-zero rows).
+// The norms are also the column scales of the threshold pivoting (threshold_pivots()), for
+// either algorithm. With labels, every column index it hands out is label[column] (the tree
+// algorithm run on relabelled columns).
+class TreeSystems {
+ public:
+  TreeSystems(const Model& model, const BaseParameterOptions& options, int samples,
+              const Deadline& deadline)
+      : model_(model),
+        options_(options),
+        samples_(samples),
+        n_(model.dof()),
+        jc_(options.layout.joint_columns()) {
+    sample(deadline);
+    const int p = options.layout.columns(n_);
+    norms_ = Eigen::VectorXd::Zero(p);
+    Eigen::MatrixXd M;
+    std::vector<int> cols;
+    for (int k = 0; k < n_; ++k) {
       deadline.check();
-      for (int j = 0; j < n; ++j) {
-        q[j] = random_position(model.joints[j], rng);
-        dq[j] = u(rng);
-        ddq[j] = u(rng);
-      }
-      forward_kinematics(model, ws, q, dq, ddq, true);
-      for (int j = 0; j < n; ++j) {
-        const LinkState& st = ws.links[j];
-        LinkSample& d = data[static_cast<std::size_t>(s) * n + j];
-        detail::wrench_blocks(st.w, st.dw, st.a, b);
-        d.Phi.setZero();
-        d.Phi.block<3, 6>(0, 0) = b.L_I;
-        d.Phi.block<3, 3>(0, 6) = b.A_skew;
-        d.Phi.block<3, 3>(3, 6) = b.K_mc;
-        d.Phi.block<3, 1>(3, 9) = b.a;
-        d.R = st.R_PJ;
-        d.p = st.p_PJ;
-        d.dq = dq[j];
-        d.ddq = ddq[j];
-        const int a = model.joints[j].parent;
-        if (a < 0) {
-          d.m = 0;
-          continue;
-        }
-        // Ancestors of j = parent a and the ancestors of a, carried into frame j.
-        const LinkSample& pa = data[static_cast<std::size_t>(s) * n + a];
-        A.resize(6, pa.m + 1);
-        for (int c = 0; c < pa.m; ++c) A.col(c) = to_child(d.R, d.p, pa.C.col(c));
-        A.col(pa.m) = to_child(d.R, d.p, detail::joint_twist(model.joints[a]));
-        d.m = orthonormal_basis(A, d.C);
-      }
+      system(k, M, cols);
+      for (int i = 0; i < kLinkParams; ++i) norms_[cols[i]] = M.col(i).norm();
+      const int off_jk = model.joints[k].parent < 0 ? kLinkParams : 2 * kLinkParams;
+      for (int c = 0; c < jc_; ++c) norms_[cols[off_jk + c]] = M.col(off_jk + c).norm();
     }
   }
 
-  // 2. Local systems. System k: columns [link k | link a | joint k | joint a] (a = parent of k,
-  // absent for a root joint); rows per state: joint k, joint a, the ancestors' basis of a.
-  auto system = [&](int k, Eigen::MatrixXd& M, std::vector<int>& cols) {
-    const int a = model.joints[k].parent;
+  const Eigen::VectorXd& norms() const { return norms_; }
+
+  void set_labels(const std::vector<int>& label) {
+    Eigen::VectorXd relabelled(norms_.size());
+    for (std::size_t c = 0; c < label.size(); ++c) relabelled[label[c]] = norms_[c];
+    norms_ = std::move(relabelled);
+    label_ = label;
+  }
+
+  // System k: columns [link k | link a | joint k | joint a] (a = parent of k, absent for a root
+  // joint); rows per state: joint k, joint a, the ancestors' basis of a.
+  void system(int k, Eigen::MatrixXd& M, std::vector<int>& cols) const {
+    const int n = n_, jc = jc_, samples = samples_;
+    auto relabel = [&](int c) { return label_.empty() ? c : label_[static_cast<std::size_t>(c)]; };
+    auto link_col = [&](int j, int i) { return relabel(kLinkParams * j + i); };
+    auto joint_col = [&](int j, int c) { return relabel(kLinkParams * n + jc * j + c); };
+    const int a = model_.joints[k].parent;
     cols.clear();
     for (int i = 0; i < kLinkParams; ++i) cols.push_back(link_col(k, i));
     if (a >= 0)
@@ -297,19 +420,19 @@ BaseParameters tree_base_parameters(const Model& model, const BaseParameterOptio
     M.setZero(static_cast<Eigen::Index>(samples) * rows_per, width);
     const int off_a = kLinkParams, off_jk = a < 0 ? kLinkParams : 2 * kLinkParams,
               off_ja = off_jk + jc;
-    const Vector6d s_k = detail::joint_twist(model.joints[k]);
-    const Vector6d s_a = a < 0 ? Vector6d::Zero() : detail::joint_twist(model.joints[a]);
+    const Vector6d s_k = detail::joint_twist(model_.joints[k]);
+    const Vector6d s_a = a < 0 ? Vector6d::Zero() : detail::joint_twist(model_.joints[a]);
     Eigen::Index r = 0;
     for (int s = 0; s < samples; ++s) {
-      const LinkSample& dk = data[static_cast<std::size_t>(s) * n + k];
+      const LinkSample& dk = data_[static_cast<std::size_t>(s) * n + k];
       M.block(r, 0, 1, kLinkParams) = s_k.transpose() * dk.Phi;
-      if (jc) detail::joint_columns(options.layout, dk.dq, dk.ddq, M.row(r).segment(off_jk, jc));
+      if (jc) detail::joint_columns(options_.layout, dk.dq, dk.ddq, M.row(r).segment(off_jk, jc));
       ++r;
       if (a < 0) continue;
-      const LinkSample& da = data[static_cast<std::size_t>(s) * n + a];
+      const LinkSample& da = data_[static_cast<std::size_t>(s) * n + a];
       M.block(r, 0, 1, kLinkParams) = to_child(dk.R, dk.p, s_a).transpose() * dk.Phi;
       M.block(r, off_a, 1, kLinkParams) = s_a.transpose() * da.Phi;
-      if (jc) detail::joint_columns(options.layout, da.dq, da.ddq, M.row(r).segment(off_ja, jc));
+      if (jc) detail::joint_columns(options_.layout, da.dq, da.ddq, M.row(r).segment(off_ja, jc));
       ++r;
       for (int c = 0; c < da.m; ++c, ++r) {
         M.block(r, 0, 1, kLinkParams) = to_child(dk.R, dk.p, da.C.col(c)).transpose() * dk.Phi;
@@ -317,19 +440,81 @@ BaseParameters tree_base_parameters(const Model& model, const BaseParameterOptio
       }
       r += 6 - da.m;  // unused rows stay zero
     }
-  };
+  }
 
-  // Column norms, each in the system where the column is "at home" (all its non-zero rows).
-  Eigen::VectorXd norms = Eigen::VectorXd::Zero(p);
+ private:
+  // 1. Sampled states: per-link quantities only, O(n) per state.
+  void sample(const Deadline& deadline) {
+    const int n = n_;
+    data_.resize(static_cast<std::size_t>(samples_) * n);
+    Workspace ws(model_);
+    Eigen::VectorXd q(n), dq(n), ddq(n);
+    detail::WrenchBlocks b;
+    Eigen::Matrix<double, 6, Eigen::Dynamic> A(6, 7);
+    for (int s = 0; s < samples_; ++s) {
+      deadline.check();
+      for (int j = 0; j < n; ++j) {
+        q[j] = position_in_range(model_.joints[j], hashed_unit(options_.seed, s, j, 0));
+        dq[j] = 2.0 * hashed_unit(options_.seed, s, j, 1) - 1.0;
+        ddq[j] = 2.0 * hashed_unit(options_.seed, s, j, 2) - 1.0;
+      }
+      forward_kinematics(model_, ws, q, dq, ddq, true);
+      for (int j = 0; j < n; ++j) {
+        const LinkState& st = ws.links[j];
+        LinkSample& d = data_[static_cast<std::size_t>(s) * n + j];
+        detail::wrench_blocks(st.w, st.dw, st.a, b);
+        d.Phi.setZero();
+        d.Phi.block<3, 6>(0, 0) = b.L_I;
+        d.Phi.block<3, 3>(0, 6) = b.A_skew;
+        d.Phi.block<3, 3>(3, 6) = b.K_mc;
+        d.Phi.block<3, 1>(3, 9) = b.a;
+        d.R = st.R_PJ;
+        d.p = st.p_PJ;
+        d.dq = dq[j];
+        d.ddq = ddq[j];
+        const int a = model_.joints[j].parent;
+        if (a < 0) {
+          d.m = 0;
+          continue;
+        }
+        // Ancestors of j = parent a and the ancestors of a, carried into frame j.
+        const LinkSample& pa = data_[static_cast<std::size_t>(s) * n + a];
+        A.resize(6, pa.m + 1);
+        for (int c = 0; c < pa.m; ++c) A.col(c) = to_child(d.R, d.p, pa.C.col(c));
+        A.col(pa.m) = to_child(d.R, d.p, detail::joint_twist(model_.joints[a]));
+        d.m = orthonormal_basis(A, d.C);
+      }
+    }
+  }
+
+  const Model& model_;
+  const BaseParameterOptions& options_;
+  int samples_, n_, jc_;
+  std::vector<LinkSample> data_;
+  Eigen::VectorXd norms_;
+  std::vector<int> label_;
+};
+
+// Numerical base parameters exploiting the tree (docs/methods/model.md, "Base parameters of large
+// trees"). A column combination x has no effect (W·x = 0) iff it moves no joint torque at any
+// state. The columns of link k are non-zero only in the rows of k and its ancestors, and every
+// ancestor row is the pairing of that ancestor's twist with the wrench the subtree exerts at k's
+// parent a, so the rows of the strict ancestors of a can be replaced, state by state, by an
+// orthonormal basis of their twists in frame a (≤ 6 rows) without changing which x have no effect.
+// The null space of each such local system over (link k, link a, their joint columns) is computed
+// by an SVD; their union spans the null space of W (regrouping moves parameters from a link to its
+// parent; checked against the dense sweep in tests/identifiability). The dependent columns are the
+// last non-zero indices of an echelon basis of that null space, exactly the columns the
+// left-to-right sweep finds dependent, and back-substitution gives K_d.
+BaseParameters tree_base_parameters(const Model& model, const BaseParameterOptions& options,
+                                    const TreeSystems& systems,
+                                    const std::vector<std::string>& names,
+                                    const Deadline& deadline) {
+  const int n = model.dof();
+  const int p = options.layout.columns(n);
+  const Eigen::VectorXd& norms = systems.norms();
   Eigen::MatrixXd M;
   std::vector<int> cols;
-  for (int k = 0; k < n; ++k) {
-    deadline.check();
-    system(k, M, cols);
-    for (int i = 0; i < kLinkParams; ++i) norms[cols[i]] = M.col(i).norm();
-    const int off_jk = model.joints[k].parent < 0 ? kLinkParams : 2 * kLinkParams;
-    for (int c = 0; c < jc; ++c) norms[cols[off_jk + c]] = M.col(off_jk + c).norm();
-  }
   const double largest = norms.size() ? norms.maxCoeff() : 0.0;
   std::vector<bool> zero(static_cast<std::size_t>(p));
   for (int c = 0; c < p; ++c) zero[c] = !(norms[c] > options.zero_tolerance * largest);
@@ -367,7 +552,7 @@ BaseParameters tree_base_parameters(const Model& model, const BaseParameterOptio
   }
   for (int link = 0; link < n; ++link) {
     deadline.check();
-    system(link, M, cols);
+    systems.system(link, M, cols);
     std::vector<int> live;  // non-zero columns of the system, scaled to unit norm
     for (int i = 0; i < static_cast<int>(cols.size()); ++i)
       if (!zero[cols[i]]) live.push_back(i);
@@ -472,7 +657,6 @@ BaseParameters tree_base_parameters(const Model& model, const BaseParameterOptio
       if (base_pos[c] >= 0) out.K_d(base_pos[c], static_cast<Eigen::Index>(j)) = -x;
     pivot[d] = std::move(v);  // reduced: later columns may refer to it
   }
-  describe(out, names, options);
   return out;
 }
 
@@ -480,6 +664,7 @@ BaseParameters tree_base_parameters(const Model& model, const BaseParameterOptio
 
 namespace {
 
+// The left-to-right sweep of a sampled regressor (names and expressions not yet written).
 BaseParameters classify_dense(const Eigen::Ref<const Eigen::MatrixXd>& W,
                               const std::vector<std::string>& names,
                               const BaseParameterOptions& options, const Deadline& deadline) {
@@ -519,7 +704,6 @@ BaseParameters classify_dense(const Eigen::Ref<const Eigen::MatrixXd>& W,
   for (int k = 0; k < r; ++k) W1.col(k) = W.col(out.base[k]);
   for (size_t k = 0; k < out.dependent.size(); ++k) W2.col(k) = W.col(out.dependent[k]);
   out.K_d = W2.cols() ? Eigen::MatrixXd(W1.colPivHouseholderQr().solve(W2)) : Eigen::MatrixXd(r, 0);
-  describe(out, names, options);
   return out;
 }
 
@@ -528,7 +712,9 @@ BaseParameters classify_dense(const Eigen::Ref<const Eigen::MatrixXd>& W,
 BaseParameters classify_columns(const Eigen::Ref<const Eigen::MatrixXd>& W,
                                 const std::vector<std::string>& names,
                                 const BaseParameterOptions& options) {
-  return classify_dense(W, names, options, Deadline(options.max_seconds));
+  BaseParameters out = classify_dense(W, names, options, Deadline(options.max_seconds));
+  describe(out, names, options);
+  return out;
 }
 
 BaseParameters compute_base_parameters(const Model& model, const BaseParameterOptions& options) {
@@ -546,10 +732,19 @@ BaseParameters compute_base_parameters(const Model& model, const BaseParameterOp
         "base parameters: the tree algorithm handles the torque regressor without coupled "
         "motors only; use BaseAlgorithm::kDense");
   }
+  const int tree_samples = options.samples > 0 ? options.samples : kTreeSamples;
+  std::vector<int> label;
   if (tree) {
-    const int samples = options.samples > 0 ? options.samples : kTreeSamples;
-    BaseParameters out = tree_base_parameters(model, options, samples, names, deadline);
-    out.samples = samples;
+    const TreeSystems systems(model, options, tree_samples, deadline);
+    BaseParameters out = tree_base_parameters(model, options, systems, names, deadline);
+    if (threshold_pivots(out, systems.norms(), n, options.pivot_threshold, label)) {
+      TreeSystems relabelled = systems;
+      relabelled.set_labels(label);
+      out =
+          unlabel(tree_base_parameters(model, options, relabelled, names, deadline), label, names);
+    }
+    describe(out, names, options);
+    out.samples = tree_samples;
     out.algorithm = BaseAlgorithm::kTree;
     return out;
   }
@@ -569,8 +764,32 @@ BaseParameters compute_base_parameters(const Model& model, const BaseParameterOp
         << " GB); use the torque regressor without coupled motors (tree algorithm)";
     throw Error(msg.str());
   }
-  BaseParameters out =
-      classify_dense(sample_regressor(model, options, samples, deadline), names, options, deadline);
+  Eigen::MatrixXd W = sample_regressor(model, options, samples, deadline);
+  BaseParameters out = classify_dense(W, names, options, deadline);
+  // Column scales of the threshold pivoting: the tree's (each column's norm in its own link's
+  // system), so that the dense sweep, the tree and the energy regressor pivot alike; with
+  // coupled-motor columns the sampled regressor's own norms.
+  Eigen::VectorXd scales;
+  if (coupled) {
+    scales = W.colwise().norm().transpose();
+  } else if (options.pivot_threshold > 0.0) {
+    BaseParameterOptions torque = options;
+    torque.regressor = BaseRegressor::kTorque;
+    torque.coupling = false;
+    scales = TreeSystems(model, torque, tree_samples, deadline).norms();
+  }
+  if (threshold_pivots(out, scales, n, options.pivot_threshold, label)) {
+    // The sweep again with each changed link's columns in their new order (within the link).
+    std::vector<std::string> relabelled(names.size());
+    for (std::size_t c = 0; c < names.size(); ++c) relabelled[label[c]] = names[c];
+    for (int k = 0; k < n; ++k) {
+      const int first = kLinkParams * k;
+      const Eigen::MatrixXd block = W.middleCols(first, kLinkParams);
+      for (int i = 0; i < kLinkParams; ++i) W.col(label[first + i]) = block.col(i);
+    }
+    out = unlabel(classify_dense(W, relabelled, options, deadline), label, names);
+  }
+  describe(out, names, options);
   out.samples = samples;
   return out;
 }

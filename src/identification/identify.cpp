@@ -39,9 +39,18 @@ void not_excited_warnings(const Model& model, const ParameterLayout& layout,
                           const BaseParameters& base, const EquationBlock& based,
                           const DataIdentifiability& data, std::vector<std::string>& warnings) {
   std::ostringstream head;
-  head << "the data excite " << data.rank << " of the model's " << base.rank
-       << " base parameters (data rank; column-scaled singular values below " << data.tolerance
-       << " x the largest count as zero): the others are not estimated (not_excited)";
+  head << std::setprecision(3) << "the data excite " << data.rank << " of the model's " << base.rank
+       << " base parameters (data rank): the others are not estimated (not_excited)";
+  if (data.plausible_magnitude > 0.0) {
+    head << "; a combination counts as determined when its standard deviation (the residual "
+            "noise "
+         << data.noise_std << " per equation over its singular value) is below its plausible "
+         << "magnitude (the whole torque, norm " << data.plausible_magnitude
+         << "): here column-scaled singular values below " << data.tolerance << " x the largest";
+  } else {
+    head << "; column-scaled singular values below " << data.tolerance
+         << " x the largest are round-off";
+  }
   warnings.push_back(head.str());
   for (int c : data.not_excited) {
     const std::string& name = base.names[static_cast<size_t>(c)];

@@ -171,7 +171,7 @@ DataIdentifiability data_identifiability(const EquationBlock& block,
                                          const DataIdentifiabilityOptions& options) {
   const Eigen::Index p = block.W.cols();
   DataIdentifiability out;
-  out.tolerance = options.relative_tolerance;
+  out.tolerance = options.roundoff_tolerance;
   out.absorbs.clear();
   // Column scaling: a zero column (no data at all) stays zero and is never kept. So does a column
   // that is zero up to round-off (below kRoundOffColumn × the largest column norm): unit scaling
@@ -195,37 +195,68 @@ DataIdentifiability data_identifiability(const EquationBlock& block,
     return out;
   }
   const auto q = static_cast<Eigen::Index>(nonzero.size());
-  // Gram matrix of the scaled columns: O(m·q²) once; its eigenvalues are σ_i², so the relative
-  // tolerance τ on σ becomes τ² on the eigenvalues (τ = 1e-6 stays well above ε·cond of the
-  // Gram matrix for column-scaled data).
-  Eigen::MatrixXd S(block.W.rows(), q);
+  const Eigen::Index m = block.W.rows();
+  Eigen::MatrixXd S(m, q);
   for (Eigen::Index c = 0; c < q; ++c) S.col(c) = block.W.col(nonzero[c]) / norms[nonzero[c]];
-  // A rank-revealing QR with column pivoting of S on the R factor of S (cheap: q × q).
+  // The R factor of S (q × q) carries everything below: singular values, the sweep, the
+  // regrouping; Qᵀy gives the residual of the fit on every column.
   Eigen::HouseholderQR<Eigen::MatrixXd> thin(S);
-  const Eigen::MatrixXd R =
-      thin.matrixQR().topRows(std::min(q, S.rows())).triangularView<Eigen::Upper>();
+  const Eigen::Index h = std::min(q, m);
+  const Eigen::MatrixXd R = thin.matrixQR().topRows(h).triangularView<Eigen::Upper>();
   const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(R).singularValues();
-  int rank = 0;
-  for (Eigen::Index i = 0; i < sv.size(); ++i) {
-    if (sv[i] > options.relative_tolerance * sv[0]) ++rank;
+  const double smax = sv.size() ? sv[0] : 0.0;
+  // The statistical rule (docs/methods/identification.md, "What the data determine"). In the
+  // scaled parameters φ = diag(‖W_c‖)·θ a unit direction v with singular value σ is fitted with
+  // standard deviation ŝ/σ (ŝ the residual noise std per equation). Its plausible magnitude:
+  // a unit-norm combination of columns with coefficient φ carries a torque of norm |φ| on a run
+  // that excites it as these data excite their best direction, and no parameter combination of
+  // a physical model carries more than the robot's whole torque, ‖y‖. A direction is determined
+  // when ŝ/σ ≤ precision·‖y‖, i.e. σ ≥ ŝ/(precision·‖y‖): below, its estimate cannot be told
+  // from zero or from a value as large as everything measured. Without a usable y (no rows to
+  // spare, no torque) only the round-off floor applies.
+  const double ynorm = block.y.size() == m && block.y.allFinite() ? block.y.norm() : 0.0;
+  double threshold = options.roundoff_tolerance * smax;
+  if (ynorm > 0.0 && m > q && options.precision > 0.0) {
+    const Eigen::VectorXd qty = thin.householderQ().adjoint() * block.y;
+    const double noise = qty.tail(m - q).norm() / std::sqrt(static_cast<double>(m - q));
+    out.noise_std = noise;
+    out.plausible_magnitude = ynorm;
+    threshold = std::max(threshold, noise / (options.precision * ynorm));
   }
-  out.rank = rank;
-  // Keep the earliest columns that are independent (a left-to-right sweep, as the model's base
-  // parameters are chosen): a column is kept when its distance to the span of the kept ones is
-  // above the tolerance.
+  out.tolerance = smax > 0.0 ? threshold / smax : options.roundoff_tolerance;
+  // Keep the earliest columns that are determined (a left-to-right sweep, as the model's base
+  // parameters are chosen): a column is kept when its distance to the span of the kept ones (the
+  // singular value of the direction it adds) passes the threshold.
   std::vector<Eigen::Index> kept_local;
   Eigen::MatrixXd basis(R.rows(), 0);
   for (Eigen::Index c = 0; c < q; ++c) {
     Eigen::VectorXd v = R.col(c);
     if (basis.cols()) v -= basis * (basis.transpose() * v);
     if (basis.cols()) v -= basis * (basis.transpose() * v);  // re-orthogonalise
-    if (v.norm() > options.relative_tolerance * sv[0] &&
-        static_cast<int>(kept_local.size()) < rank) {
+    if (v.norm() > threshold) {
       basis.conservativeResize(Eigen::NoChange, basis.cols() + 1);
       basis.col(basis.cols() - 1) = v / v.norm();
       kept_local.push_back(c);
     }
   }
+  // Each kept column adds a direction above the threshold, but together they may still hold one
+  // below it (σ_min of a triangular factor can be far below its smallest pivot): leave out the
+  // kept column that carries most of the weakest direction (the later one on a tie), until none
+  // is left.
+  while (!kept_local.empty()) {
+    Eigen::MatrixXd Rk(R.rows(), static_cast<Eigen::Index>(kept_local.size()));
+    for (size_t i = 0; i < kept_local.size(); ++i)
+      Rk.col(static_cast<Eigen::Index>(i)) = R.col(kept_local[i]);
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(Rk, Eigen::ComputeThinV);
+    const Eigen::Index last = svd.singularValues().size() - 1;
+    if (svd.singularValues()[last] > threshold) break;
+    const Eigen::VectorXd weakest = svd.matrixV().col(last).cwiseAbs();
+    Eigen::Index drop = 0;
+    for (Eigen::Index i = 1; i < weakest.size(); ++i)
+      if (weakest[i] >= weakest[drop] * (1.0 - 1e-9)) drop = i;
+    kept_local.erase(kept_local.begin() + drop);
+  }
+  out.rank = static_cast<int>(kept_local.size());
   std::vector<bool> is_kept(static_cast<size_t>(p), false);
   for (Eigen::Index c : kept_local) is_kept[static_cast<size_t>(nonzero[c])] = true;
   for (Eigen::Index c = 0; c < p; ++c) {
@@ -239,7 +270,7 @@ DataIdentifiability data_identifiability(const EquationBlock& block,
   out.absorbs.assign(out.kept.size(), {});
   for (Eigen::Index c = 0; c < q; ++c) {
     const int col = nonzero[c];
-    if (is_kept[static_cast<size_t>(col)]) continue;
+    if (is_kept[static_cast<size_t>(col)] || kept_local.empty()) continue;
     const Eigen::VectorXd k = solver.solve(Eigen::VectorXd(R.col(c)));
     for (Eigen::Index i = 0; i < k.size(); ++i) {
       if (std::abs(k[i]) < options.absorb_threshold) continue;

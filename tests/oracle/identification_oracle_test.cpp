@@ -201,11 +201,15 @@ TEST(IdentificationOracle, ResidualAutocorrelationIsMeasuredAndWarned) {
 // velocities and accelerations derived from the sampled q as a user's log gives them.
 // Differential model: every base parameter is data-identifiable and has a finite σ (a guard: these
 // runs give full rank with or without estimate_block's unit-norm re-solve). Integral model, the
-// issue's own: on these runs its column-scaled energy equations have one (puma560, Fo6) or two
-// (TX40, Fvm6 and Fcm6) directions at 3–6e-7 of the largest singular value (differential: 2.3e-3
-// on the same data), below data_identifiability's 1e-6, so data rank 57 of 58 and 59 of 61; the
-// contract item 3 asks for still holds: those are named not excited with a warning, every
-// estimate has a finite σ, none is reported with σ = null (docs/methods/identification.md §4).
+// issue's own: noise-free, its column-scaled energy equations have directions at 3–6e-7 of the
+// largest singular value (differential: 2.3e-3 on the same data) that the exact data still fix,
+// so every base parameter is determined (issue 25 item 1: the statistical data-rank rule,
+// docs/methods/identification.md §5a; the old 1e-6 ratio dropped them). With 0.05 N·m torque
+// noise the energy equations of this 10 s run cannot fix those directions to better than the
+// whole measured energy (measured: data rank 54 of 58 and 50 of 61; under the 1e-6 ratio they
+// were "estimated" with σ of 10–1000× their truths), so they are named not excited; noise can
+// only lose directions, never add them. The contract of issue 11 item 3 holds either way: each
+// is named with a warning, every estimate has a finite σ, none is reported with σ = null.
 class SixJointKdl : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(SixJointKdl, RunWhereEveryJointMovesHasFullDataRank) {
@@ -217,6 +221,7 @@ TEST_P(SixJointKdl, RunWhereEveryJointMovesHasFullDataRank) {
   r.ddq.resize(0, 0);
   std::mt19937 rng(9);
   std::normal_distribution<double> noise;
+  int noise_free_integral_rank = -1;
   for (const double sigma : {0.0, 0.05}) {
     JointRecord run = r;
     run.tau = exact;
@@ -233,8 +238,13 @@ TEST_P(SixJointKdl, RunWhereEveryJointMovesHasFullDataRank) {
       if (!integral) {
         EXPECT_EQ(res.data_rank, res.rank) << "torque noise " << sigma;
         for (const auto& w : res.warnings) EXPECT_EQ(w.find("rank"), std::string::npos) << w;
+      } else if (sigma == 0.0) {
+        EXPECT_EQ(res.data_rank, res.rank) << "noise-free integral equations";
+        noise_free_integral_rank = res.data_rank;
       } else {
-        EXPECT_GE(res.data_rank, res.rank - 2) << "torque noise " << sigma;
+        EXPECT_LE(res.data_rank, noise_free_integral_rank) << "noise added a direction";
+        // A guard against a rule that collapses: the measured losses are 4 and 11 directions.
+        EXPECT_GE(res.data_rank, res.rank - 15) << "torque noise " << sigma;
       }
       EXPECT_EQ(res.not_excited.size(), static_cast<size_t>(res.rank - res.data_rank)) << label;
       ASSERT_EQ(res.estimate.std_dev.size(), res.data_rank) << label;

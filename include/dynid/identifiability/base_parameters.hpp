@@ -36,7 +36,14 @@ struct BaseParameterOptions {
   unsigned seed = 20261123;       ///< fixed seed: the same model gives the same base set every time
   double zero_tolerance = 1e-10;  ///< column norm / largest column norm below this: no effect
   double dependence_tolerance = 1e-8;  ///< residual / own norm below this: linearly dependent
-  double coefficient_digits = 6;       ///< significant digits of K_d in the expressions
+  /// Threshold pivoting of the regrouping: in units of columns scaled to unit norm, a column is
+  /// made dependent only where its null vector gives it at least this weight; otherwise it trades
+  /// places with the base column of highest index that has it (docs/methods/model.md,
+  /// "Well-conditioned base columns"). Keeps the base columns well conditioned when a joint axis
+  /// is nearly, not exactly, along a frame axis; changes nothing where Gautier's rule already
+  /// pivots on weights above it (every built-in robot). 0 = Gautier's rule alone.
+  double pivot_threshold = 0.1;
+  double coefficient_digits = 6;  ///< significant digits of K_d in the expressions
   double max_seconds = 0.0;  ///< wall-clock limit [s]; 0 = none; beyond it dynid::Error is thrown
 };
 

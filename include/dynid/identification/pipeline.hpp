@@ -56,14 +56,19 @@ EquationBlock stack_equations(const std::vector<EquationBlock>& blocks, int gap 
 /// base.layout_names. Throws dynid::Error otherwise.
 EquationBlock select_base_columns(const EquationBlock& block, const BaseParameters& base);
 
-/// What the data determine of a block's columns (issue 11 item 3): the rank of the column-scaled
-/// W (each column divided by its 2-norm, so the rank does not depend on units), the columns a
-/// rank-revealing QR keeps, and those the data leave undetermined.
+/// What the data determine of a block's columns (issue 11 item 3; issue 25 item 1): the columns
+/// scaled to unit 2-norm (so nothing depends on units), the directions the data fix to a useful
+/// precision given the noise they show (DataIdentifiabilityOptions::precision), the columns a
+/// left-to-right sweep keeps, and those the data leave undetermined.
 struct DataIdentifiability {
-  int rank = 0;                  ///< data rank of the block (≤ columns)
-  double tolerance = 0.0;        ///< relative singular-value threshold used
-  std::vector<int> kept;         ///< columns estimated, increasing
-  std::vector<int> not_excited;  ///< columns the data do not determine, increasing
+  int rank = 0;  ///< data rank of the block: the columns kept (≤ columns)
+  /// Singular value (column-scaled W, relative to the largest) below which a direction is not
+  /// determined: max(roundoff_tolerance, noise_std / (precision · plausible_magnitude) / σ_max).
+  double tolerance = 0.0;
+  double noise_std = 0.0;            ///< ŝ: residual std per equation of the fit on every column
+  double plausible_magnitude = 0.0;  ///< ‖y‖, the largest torque a direction can plausibly carry
+  std::vector<int> kept;             ///< columns estimated, increasing
+  std::vector<int> not_excited;      ///< columns the data do not determine, increasing
   /// Per kept column, the not-excited columns it absorbs on these data (name, coefficient): the
   /// kept estimate is θ_kept + Σ c·θ_not_excited (a data regrouping, like K_d for the model).
   std::vector<std::vector<std::pair<int, double>>> absorbs;
@@ -71,20 +76,28 @@ struct DataIdentifiability {
 
 /// Options of data_identifiability (Ceres style).
 struct DataIdentifiabilityOptions {
-  /// Relative tolerance on the singular values of the column-scaled W: a direction whose singular
-  /// value is below tolerance·σ_max is not excited. Column scaling turns every excited column into
-  /// a unit vector, so σ_i/σ_max measures how far a combination of unit-norm columns is from zero;
-  /// 1e-6 means the data fit that combination of parameters to within one part in a million of the
-  /// columns' own size — far below any regressor noise (positions are known to ~1e-4 relative at
-  /// best) yet far above round-off (max(m, p)·ε ≈ 1e-10 at 10⁶ rows), so it separates "the data
-  /// cannot tell" from "the data tell, poorly" (the latter is a large σ, reported as such).
-  double relative_tolerance = 1e-6;
+  /// A direction of the column-scaled W (unit right singular vector v, singular value σ) is
+  /// estimated with standard deviation ŝ/σ in the scaled parameters φ = diag(‖W_c‖)·θ, where ŝ
+  /// is the residual std per equation. A unit-norm combination of columns with coefficient φ
+  /// carries a torque of norm |φ| on a run that excites it fully; no combination of a physical
+  /// model's parameters carries more than the robot's whole torque ‖y‖ (its plausible magnitude).
+  /// The direction is determined when ŝ/σ ≤ precision·‖y‖. 1 = its standard deviation must not
+  /// exceed its plausible magnitude (issue 25); below it the estimate cannot be told from 0 nor
+  /// from everything measured (docs/methods/identification.md, "What the data determine").
+  double precision = 1.0;
+  /// Numerical floor, whatever the noise (nearly noise-free data, no residual degrees of
+  /// freedom): a singular value below this × the largest is not determined. Below a column-scaled
+  /// condition number of 1e8 the estimator's intervals lose their digits (the simulation of
+  /// docs/methods/identification.md: 49–59 % coverage at 5e-9 and 5e-10, all at 5e-8).
+  double roundoff_tolerance = 1e-8;
   /// A data-regrouping coefficient below this (relative to the column scales) is round-off.
   double absorb_threshold = 1e-6;
 };
 
 /// Rank of the data and the columns they determine (see DataIdentifiability). A column that is
-/// exactly zero on the data (a joint that never moved above its noise) is never kept.
+/// exactly zero on the data (a joint that never moved above its noise) is never kept. Uses
+/// block.y for the noise and the plausible magnitude; without it (empty, or no more rows than
+/// columns) only the round-off floor applies.
 DataIdentifiability data_identifiability(const EquationBlock& block,
                                          const DataIdentifiabilityOptions& options = {});
 
