@@ -584,8 +584,9 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     const PhysicalCheck c = physical_parameters_of_result(
         model, result, options, records.front(), "--physical",
         first_run_fit ? std::optional<double>(first_run_fit->relative_error_all) : std::nullopt);
-    physical_parameters_to_json(c.fit, c.physical_error, c.free_error, out);
+    physical_parameters_to_json(c.fit, c.physical_error, c.free_error, out, c.warnings);
     std::cout << physical_parameters_text(c.fit, c.physical_error, c.free_error);
+    for (const std::string& w : c.warnings) warn("--physical: " + w);
   }
   write_json(o.out, out);
   std::cout << "wrote " << o.out << '\n';
@@ -705,7 +706,8 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
   }
   ValidationResult result;
   try {
-    result = validate_torques(model, record, names, values, options, identified.not_excited);
+    result = validate_torques(model, record, names, values, options, identified.not_excited,
+                              nominal_completion_of_result(model, identified, v.params));
   } catch (const UsageError& e) {  // --zero-velocity is the user's own when given
     if (!v.zero_velocity.empty()) throw;
     throw stored_option_error(e, v.params);
@@ -722,6 +724,7 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
             "keeps only the reference's band and would hide the noise and the loop's response "
             "the model must predict)");
   echo_choices("validate", read, result.choices);
+  for (const std::string& w : result.warnings) warn("validate: " + w);
   if (!result.rms.allFinite() || !result.relative_error.allFinite() ||
       !std::isfinite(result.relative_error_all) || !std::isfinite(result.relative_error_all_rows)) {
     throw Error("the predicted torques overflow: the parameter values in '" + v.params +

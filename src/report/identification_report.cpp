@@ -382,6 +382,9 @@ nlohmann::json validation_to_json(const Model& model, const ValidationResult& v)
              "keep every row"},
             {"zero_velocity_threshold", numbers(v.zero_velocity_threshold)},
             {"rows", v.rows_excluded}}},
+          {"completed", v.completed},
+          {"filled_share", json_number(v.filled_share)},
+          {"warnings", v.warnings},
           {"choices", choices},
           {"version", kVersion}};
 }

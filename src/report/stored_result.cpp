@@ -130,7 +130,8 @@ void add_stored_known_friction(const IdentifiedResultFile& identified, const std
 }
 
 CompletedModel completed_model_of_result(const Model& model, const IdentifiedResultFile& identified,
-                                         const std::string& path) {
+                                         const std::string& path,
+                                         const ModelCompletionOptions& completion) {
   IdentifyOptions options;
   try {
     options.layout = stored_layout(ResultFileOptions{identified.options, path});
@@ -142,7 +143,20 @@ CompletedModel completed_model_of_result(const Model& model, const IdentifiedRes
   add_stored_known_friction(identified, path, model, names, values, options);
   return complete_identified_model(model, names, values, identified.std_devs,
                                    identified.not_excited, identified.data_regrouping,
-                                   identified.covariance, options);
+                                   identified.covariance, options, completion);
+}
+
+ParameterCompletion nominal_completion_of_result(const Model& model,
+                                                 const IdentifiedResultFile& identified,
+                                                 const std::string& path) {
+  ParameterCompletion out;
+  if (identified.not_excited.empty()) return out;
+  ModelCompletionOptions only_not_excited;
+  only_not_excited.max_relative_std = 0.0;
+  const CompletedModel c = completed_model_of_result(model, identified, path, only_not_excited);
+  out.names = c.names;
+  out.values = c.values;
+  return out;
 }
 
 nlohmann::json parameter_sources_json(const CompletedModel& c) {

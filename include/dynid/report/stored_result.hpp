@@ -17,6 +17,7 @@
 #include "dynid/identification/identify.hpp"
 #include "dynid/identification/option_text.hpp"
 #include "dynid/identification/record.hpp"
+#include "dynid/identification/validation.hpp"
 #include "dynid/model/model.hpp"
 #include "dynid/physical/completed_model.hpp"
 #include "dynid/regressor/parameter_layout.hpp"
@@ -91,7 +92,17 @@ void add_stored_known_friction(const IdentifiedResultFile& identified, const std
 /// badly determined at the nominal model's values, said in CompletedModel::warnings. Throws
 /// dynid::Error naming `path` (an invalid option, a name that is no base parameter).
 CompletedModel completed_model_of_result(const Model& model, const IdentifiedResultFile& identified,
-                                         const std::string& path);
+                                         const std::string& path,
+                                         const ModelCompletionOptions& completion = {});
+
+/// What validate_torques() predicts with where a stored result leaves base parameters undetermined
+/// and a run excites them (issue 25 item 2): the result completed with only its not excited
+/// parameters at the nominal model's values (completed_model_of_result() with max_relative_std 0:
+/// the badly determined but estimated ones keep their estimates, so a run like the identification
+/// run is predicted exactly as before). Throws as completed_model_of_result().
+ParameterCompletion nominal_completion_of_result(const Model& model,
+                                                 const IdentifiedResultFile& identified,
+                                                 const std::string& path);
 
 /// `parameter_sources` of a JSON output: identified, nominal_not_excited,
 /// nominal_badly_determined, max_shift_sigma (CompletedModel).
