@@ -389,8 +389,16 @@ void run_experiment(const IdentifyCliOptions& o, const IdentifyOptions& options,
   } else if (o.model == "friction") {
     FrictionExperimentOptions fo;
     fo.confidence_level = options.confidence_level;
-    FrictionExperimentResult r =
-        fit_friction_experiment(compensation_model(model, o.params), runs, j, fo);
+    Model compensation = model;
+    if (!o.params.empty()) {
+      const IdentifiedResultFile f = read_identification_result(o.params);
+      require_same_robot(f.robot, model.name, "'" + o.params + "'", "give a result of this robot");
+      // A gravity or decoupled result compensates the gravity (and inertia) of this joint
+      // (Bona & Curatella's chain); a base-parameter result the whole rigid body.
+      add_stored_friction_compensation(model, f, o.params, j, fo);
+      if (f.experiment.empty()) compensation = compensation_model(model, o.params);
+    }
+    FrictionExperimentResult r = fit_friction_experiment(compensation, runs, j, fo);
     r.choices.insert(r.choices.begin(), choices.begin(), choices.end());
     result = friction_experiment_to_json(model, r, used);
   } else {
@@ -783,7 +791,8 @@ void add_identify_command(CLI::App& app) {
   cmd->add_option("--joint", o->joint, "gravity, friction, decoupled: the joint (1-based)");
   cmd->add_option("--params", o->params,
                   "friction: result.json whose identified model compensates inertia and gravity "
-                  "(default: the robot's nominal model)");
+                  "(default: the robot's nominal model), or the --model gravity or decoupled "
+                  "result of the same joint, whose gravity (and inertia) is used instead");
   cmd->add_option("--friction-known", o->friction_known,
                   "Result JSON of identify --model friction or decoupled (repeat per joint): its "
                   "asymmetric friction is subtracted from the measured torque and only the "

@@ -315,6 +315,18 @@ IdentifiedResultFile identification_result_from_json(const nlohmann::json& j,
                   "dynid identify");
     }
   }
+  const auto experiment = j.find("experiment");
+  if (experiment != j.end() && experiment->is_string()) {
+    out.experiment = experiment->get<std::string>();
+    const auto joint = j.find("joint");
+    if (joint == j.end() || !joint->is_number_integer() || joint->get<int>() < 1) {
+      throw Error("'" + path +
+                  "': an experiment result needs its 1-based 'joint'; write the file "
+                  "with dynid identify --model " +
+                  out.experiment);
+    }
+    out.experiment_joint = joint->get<int>();
+  }
   return out;
 }
 

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "dynid/common/error.hpp"
+#include "dynid/experiments/friction_experiment.hpp"
 #include "dynid/identification/identify.hpp"
 #include "dynid/identification/option_text.hpp"
 #include "dynid/identification/record.hpp"
@@ -103,6 +104,17 @@ CompletedModel completed_model_of_result(const Model& model, const IdentifiedRes
 ParameterCompletion nominal_completion_of_result(const Model& model,
                                                  const IdentifiedResultFile& identified,
                                                  const std::string& path);
+
+/// The compensation a friction experiment of `joint` (0-based) takes from a stored result `path`
+/// (Bona & Curatella's chain, seed 2 §3.2: the friction runs compensated with the gravity the
+/// slopes identified): for a `--model gravity` result its gravity of the joint (k·sin(q_J + q_off)
+/// or the base parameters over all q), for a `--model decoupled` result its gravity and
+/// equivalent inertia; nothing for a base-parameter result (identify's, used through
+/// completed_model_of_result()). Throws dynid::Error naming `path` for a result of another joint
+/// or of a friction experiment.
+void add_stored_friction_compensation(const Model& model, const IdentifiedResultFile& identified,
+                                      const std::string& path, int joint,
+                                      FrictionExperimentOptions& options);
 
 /// `parameter_sources` of a JSON output: identified, nominal_not_excited,
 /// nominal_badly_determined, max_shift_sigma (CompletedModel).
