@@ -428,7 +428,8 @@ nlohmann::json payload_from_torques(const Model& model, const std::string& link_
     {
       py::gil_scoped_release release;
       const ValidationResult predicted = validate_torques(
-          model, loaded_raw, identified.names, identified.values, identify, identified.not_excited);
+          model, loaded_raw, identified.names, identified.values, identify, identified.not_excited,
+          nominal_completion_of_result(model, identified, "reference"));
       r = identify_load_from_unexplained_torques(model, link, frame, predicted.processed.record,
                                                  predicted.predicted,
                                                  predicted.zero_velocity_threshold, options);
@@ -618,7 +619,7 @@ PYBIND11_MODULE(dynid, m) {
           const PhysicalCheck c = physical_parameters_of_result(
               model, result, options, record, "physical=True",
               replay ? std::optional<double>(replay->relative_error_all) : std::nullopt);
-          physical_parameters_to_json(c.fit, c.physical_error, c.free_error, out);
+          physical_parameters_to_json(c.fit, c.physical_error, c.free_error, out, c.warnings);
         }
         py::gil_scoped_acquire acquire;
         return to_python(out);
@@ -648,7 +649,8 @@ PYBIND11_MODULE(dynid, m) {
         {
           py::gil_scoped_release release;
           v = validate_torques(model, record, identified.names, identified.values, options,
-                               identified.not_excited);
+                               identified.not_excited,
+                               nominal_completion_of_result(model, identified, "result"));
         }
         std::vector<std::string> joints;
         for (const auto& joint : model.joints) joints.push_back(joint.name);

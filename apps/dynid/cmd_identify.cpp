@@ -389,8 +389,16 @@ void run_experiment(const IdentifyCliOptions& o, const IdentifyOptions& options,
   } else if (o.model == "friction") {
     FrictionExperimentOptions fo;
     fo.confidence_level = options.confidence_level;
-    FrictionExperimentResult r =
-        fit_friction_experiment(compensation_model(model, o.params), runs, j, fo);
+    Model compensation = model;
+    if (!o.params.empty()) {
+      const IdentifiedResultFile f = read_identification_result(o.params);
+      require_same_robot(f.robot, model.name, "'" + o.params + "'", "give a result of this robot");
+      // A gravity or decoupled result compensates the gravity (and inertia) of this joint
+      // (Bona & Curatella's chain); a base-parameter result the whole rigid body.
+      add_stored_friction_compensation(model, f, o.params, j, fo);
+      if (f.experiment.empty()) compensation = compensation_model(model, o.params);
+    }
+    FrictionExperimentResult r = fit_friction_experiment(compensation, runs, j, fo);
     r.choices.insert(r.choices.begin(), choices.begin(), choices.end());
     result = friction_experiment_to_json(model, r, used);
   } else {
@@ -584,8 +592,9 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     const PhysicalCheck c = physical_parameters_of_result(
         model, result, options, records.front(), "--physical",
         first_run_fit ? std::optional<double>(first_run_fit->relative_error_all) : std::nullopt);
-    physical_parameters_to_json(c.fit, c.physical_error, c.free_error, out);
+    physical_parameters_to_json(c.fit, c.physical_error, c.free_error, out, c.warnings);
     std::cout << physical_parameters_text(c.fit, c.physical_error, c.free_error);
+    for (const std::string& w : c.warnings) warn("--physical: " + w);
   }
   write_json(o.out, out);
   std::cout << "wrote " << o.out << '\n';
@@ -705,7 +714,8 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
   }
   ValidationResult result;
   try {
-    result = validate_torques(model, record, names, values, options, identified.not_excited);
+    result = validate_torques(model, record, names, values, options, identified.not_excited,
+                              nominal_completion_of_result(model, identified, v.params));
   } catch (const UsageError& e) {  // --zero-velocity is the user's own when given
     if (!v.zero_velocity.empty()) throw;
     throw stored_option_error(e, v.params);
@@ -722,6 +732,7 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
             "keeps only the reference's band and would hide the noise and the loop's response "
             "the model must predict)");
   echo_choices("validate", read, result.choices);
+  for (const std::string& w : result.warnings) warn("validate: " + w);
   if (!result.rms.allFinite() || !result.relative_error.allFinite() ||
       !std::isfinite(result.relative_error_all) || !std::isfinite(result.relative_error_all_rows)) {
     throw Error("the predicted torques overflow: the parameter values in '" + v.params +
@@ -780,7 +791,8 @@ void add_identify_command(CLI::App& app) {
   cmd->add_option("--joint", o->joint, "gravity, friction, decoupled: the joint (1-based)");
   cmd->add_option("--params", o->params,
                   "friction: result.json whose identified model compensates inertia and gravity "
-                  "(default: the robot's nominal model)");
+                  "(default: the robot's nominal model), or the --model gravity or decoupled "
+                  "result of the same joint, whose gravity (and inertia) is used instead");
   cmd->add_option("--friction-known", o->friction_known,
                   "Result JSON of identify --model friction or decoupled (repeat per joint): its "
                   "asymmetric friction is subtracted from the measured torque and only the "

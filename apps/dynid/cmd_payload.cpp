@@ -100,7 +100,8 @@ void write_result(const PayloadCliOptions& cli, const LoadIdentificationResult& 
 // determine.
 void write_torque_result(const PayloadCliOptions& cli, const LoadIdentificationResult& r,
                          const Model& model, int link,
-                         const std::vector<std::pair<std::string, std::string>>& choices) {
+                         const std::vector<std::pair<std::string, std::string>>& choices,
+                         const ValidationResult* reference = nullptr) {
   std::vector<std::string> joints;
   for (const auto& joint : model.joints) joints.push_back(joint.name);
   const nlohmann::json where = {{"robot", model.name},
@@ -111,8 +112,12 @@ void write_torque_result(const PayloadCliOptions& cli, const LoadIdentificationR
     if (std::find(r.not_excited.begin(), r.not_excited.end(), name) == r.not_excited.end())
       determined.push_back(name);
   }
-  const nlohmann::json extra = {{"reference", cli.reference},
-                                {"determined_by_torques", determined}};
+  nlohmann::json extra = {{"reference", cli.reference}, {"determined_by_torques", determined}};
+  if (reference != nullptr) {
+    // The reference model's parameters predicted at nominal values on this run (issue 25 item 2).
+    extra["completed"] = reference->completed;
+    extra["filled_share"] = reference->filled_share;
+  }
   write_result(cli, r, "joint_torques", where, extra, choices, joints, true);
 }
 
@@ -138,7 +143,9 @@ void run_payload_from_result(const PayloadCliOptions& cli, LoadIdentificationOpt
   }
   const JointRecord loaded_raw = read_joint_record(cli.data, model, file);
   const ValidationResult predicted = validate_torques(
-      model, loaded_raw, identified.names, identified.values, identify, identified.not_excited);
+      model, loaded_raw, identified.names, identified.values, identify, identified.not_excited,
+      nominal_completion_of_result(model, identified, cli.reference));
+  for (const std::string& w : predicted.warnings) std::cerr << "warning: payload: " << w << '\n';
   // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
   options.hac_covariance = identify.signal.filter;
   options.record_history = false;
@@ -151,7 +158,7 @@ void run_payload_from_result(const PayloadCliOptions& cli, LoadIdentificationOpt
                            "' (identify result) predicted on this run as dynid validate does; "
                            "rows below its zero-velocity thresholds are left out of the load fit "
                            "too; its own uncertainty is not propagated");
-  write_torque_result(cli, r, model, link, choices);
+  write_torque_result(cli, r, model, link, choices, &predicted);
 }
 
 // `--link LINK --reference unloaded.csv`: robot and load together from joint torques.

@@ -441,11 +441,15 @@ EquationBlock project_equations(const EquationBlock& block, const SignalProjecto
 
 std::string projected_statistics(Estimate& e, const EquationBlock& block,
                                  Eigen::Index effective_rows, bool weighted,
-                                 const EstimationOptions& options, const Eigen::VectorXi& channel) {
+                                 const EstimationOptions& options, const Eigen::VectorXi& channel,
+                                 const Eigen::VectorXd& remainder_variance) {
   const Eigen::Index rows = block.W.rows(), p = block.W.cols();
   if (channel.size() != 0 && channel.size() != rows)
     throw Error("projected_statistics: " + std::to_string(channel.size()) + " channel labels for " +
                 std::to_string(rows) + " rows");
+  if (remainder_variance.size() != 0 && remainder_variance.size() != rows)
+    throw Error("projected_statistics: " + std::to_string(remainder_variance.size()) +
+                " remainder variances for " + std::to_string(rows) + " rows");
   Eigen::VectorXd w = Eigen::VectorXd::Ones(rows);
   if (weighted && e.group_variance.size()) {
     for (Eigen::Index i = 0; i < rows; ++i) {
@@ -470,11 +474,45 @@ std::string projected_statistics(Estimate& e, const EquationBlock& block,
       inv2[k] = 1.0 / (sv[k] * sv[k]);
       ++rank;
     }
-  if (effective_rows <= rank)
-    throw Error("the projected signals span " + std::to_string(effective_rows) +
-                " dimensions (all joints and runs) for " + std::to_string(rank) +
-                " parameters: no degrees of freedom are left for the intervals; use a reference "
-                "with more harmonics or more runs");
+  const Eigen::MatrixXd v_all = svd.matrixV();
+  if (effective_rows <= rank) {
+    // The estimate exists; the projected residual has no dimension left to measure the noise. The
+    // torque remainder u − P·u outside the projected span holds it instead: for noise that is
+    // white across the band, each projected dimension carries the remainder's variance σ_j² of its
+    // channel, so cov(θ̂) = B·(Σ_i σ_i²·w̃_i·w̃_iᵀ)·B, B = (W̃ᵀW̃)⁻¹ (docs/methods/closed_loop.md,
+    // "Intervals without degrees of freedom").
+    std::ostringstream m;
+    m << "the projected signals span " << effective_rows << " dimensions (all joints and runs) for "
+      << rank << " parameters, so no degrees of freedom are left in the projected residual";
+    if (remainder_variance.size() != rows || !remainder_variance.allFinite() ||
+        !(remainder_variance.maxCoeff() > 0.0))
+      throw Error(m.str() +
+                  " and no torque remainder to take the noise from; use a reference "
+                  "with more harmonics or more runs");
+    const Eigen::MatrixXd bread_scaled = v_all * inv2.asDiagonal() * v_all.transpose();
+    const Eigen::MatrixXd Ws = Ww * s.cwiseInverse().asDiagonal();
+    const Eigen::MatrixXd meat =
+        Ws.transpose() * remainder_variance.cwiseProduct(w.cwiseAbs2()).asDiagonal() * Ws;
+    const Eigen::MatrixXd cov_scaled = bread_scaled * meat * bread_scaled;
+    e.covariance = s.cwiseInverse().asDiagonal() * cov_scaled * s.cwiseInverse().asDiagonal();
+    e.residual_variance = remainder_variance.mean();
+    // The remainder's variance comes from thousands of samples per channel: normal quantiles.
+    e.degrees_of_freedom = std::max<Eigen::Index>(rows - rank, 1000);
+    e.covariance_kind = "torque remainder, projected";
+    e.std_dev_white.resize(0);
+    e.ci_lower_white.resize(0);
+    e.ci_upper_white.resize(0);
+    e.summary.warnings.push_back(
+        m.str() +
+        ": the intervals take the noise from the torque remainder outside that span "
+        "(white across the band assumed); a reference with more harmonics or more "
+        "runs, or --repeat periods (the spread of per-period estimates, Bona & "
+        "Curatella's Table 3), measures it on the projected equations themselves");
+    fill_parameter_statistics(e, options);
+    return "(W~^T W~)^-1 (sum_i s_i^2 w~_i w~_i^T) (W~^T W~)^-1 with s_j^2 the variance of joint "
+           "j's torque remainder u - P u: " +
+           m.str();
+  }
   const double dof = static_cast<double>(effective_rows - rank);
   const double sigma2 = ew.squaredNorm() / dof;
   const Eigen::MatrixXd v = svd.matrixV();

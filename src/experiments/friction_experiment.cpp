@@ -52,7 +52,14 @@ FrictionExperimentResult fit_friction_experiment(const Model& model,
     jt.friction.Fv = jt.friction.Fc = jt.friction.Fo = jt.friction.Fva = jt.friction.Fca = 0.0;
   }
   Workspace ws(rigid);
-  Eigen::VectorXd tau(n);
+  Eigen::VectorXd tau(n), rest(n);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+  const bool decoupled = std::isfinite(options.equivalent_inertia);
+  if (options.gravity && options.gravity->joint() != joint) {
+    throw UsageError("the gravity given is that of joint " +
+                     std::to_string(options.gravity->joint() + 1) + ", not of joint " +
+                     std::to_string(joint + 1) + "; give the gravity result of this joint");
+  }
   double peak = 0.0;
   for (const auto& p : runs) peak = std::max(peak, p.record.dq.col(joint).cwiseAbs().maxCoeff());
   double noise = 0.0;
@@ -93,10 +100,19 @@ FrictionExperimentResult fit_friction_experiment(const Model& model,
     for (Eigen::Index k = 0; k < p.record.t.size(); ++k) {
       const double v = p.record.dq(k, joint);
       if (std::abs(v) < threshold) continue;
-      rnea(rigid, ws, p.record.q.row(k).transpose(), p.record.dq.row(k).transpose(),
-           p.record.ddq.row(k).transpose(), tau);
+      const Eigen::VectorXd q = p.record.q.row(k).transpose();
+      rnea(rigid, ws, q, p.record.dq.row(k).transpose(), p.record.ddq.row(k).transpose(), tau);
+      double compensation = tau[joint];
+      if (options.gravity || decoupled) {
+        // Split the model's torque into its gravity and the rest, replace what is given.
+        rnea(rigid, ws, q, zero, zero, rest);
+        const double gravity = options.gravity ? options.gravity->torque(q) : rest[joint];
+        const double motion = decoupled ? options.equivalent_inertia * p.record.ddq(k, joint)
+                                        : tau[joint] - rest[joint];
+        compensation = gravity + motion;
+      }
       W.row(i) = detail::friction_columns(p, k, joint).transpose();
-      y[i] = p.record.tau(k, joint) - tau[joint];
+      y[i] = p.record.tau(k, joint) - compensation;
       positive += v > 0.0;
       negative += v < 0.0;
       const double along = p.record.ddq(k, joint) * (v > 0.0 ? 1.0 : -1.0);
@@ -160,8 +176,13 @@ FrictionExperimentResult fit_friction_experiment(const Model& model,
     << " x the velocity noise std)): " << out.rows_left_out << " of " << total;
   out.choices.emplace_back("zero_velocity", c.str());
   out.choices.emplace_back(
-      "compensation", "inertia, Coriolis, centripetal and gravity torques of model '" + model.name +
-                          "' subtracted (its friction left out)");
+      "compensation",
+      std::string(decoupled ? "the decoupled result's equivalent inertia M_J*ddq_J"
+                            : "inertia, Coriolis and centripetal torques of model '" + model.name +
+                                  "' (its friction left out)") +
+          (options.gravity ? " and the gravity identified by the experiment given (seed 2 §3.2)"
+                           : " and its gravity") +
+          " subtracted");
   out.choices.emplace_back("coulomb_columns", expected_sign
                                                   ? "filtered expected sign (parallel filtering)"
                                                   : "[dq > 0] and -[dq < 0]");

@@ -277,7 +277,73 @@ class GravityRow {
   Eigen::MatrixXd Y_;
 };
 
+constexpr int kGravityPoses = 200;
+constexpr unsigned kGravityPoseSeed = 20261130;
+
+// The structural gravity base parameters of row J: its link columns sampled at random poses,
+// classified left to right (so MX, MY, MZ lead and masses regroup into them). Fixed seed: the
+// same model and joint always give the same names.
+BaseParameters gravity_row_base(const Model& model, int joint) {
+  const int n = model.dof();
+  GravityRow gravity_row(model, joint);
+  const std::vector<std::string> link_names = ParameterLayout::rigid().names(n);
+  constexpr int kPoses = kGravityPoses;
+  std::mt19937 rng(kGravityPoseSeed);
+  std::uniform_real_distribution<double> angle(-3.14159265358979323846, 3.14159265358979323846);
+  Eigen::MatrixXd random_rows(kPoses, kLinkParams * n);
+  for (int s = 0; s < kPoses; ++s) {
+    Eigen::VectorXd q(n);
+    for (int i = 0; i < n; ++i) q[i] = angle(rng);
+    random_rows.row(s) = gravity_row(q);
+  }
+  BaseParameterOptions bo;
+  bo.layout = ParameterLayout::rigid();
+  return classify_columns(random_rows, link_names, bo);
+}
+
 }  // namespace
+
+JointGravityModel JointGravityModel::sinusoid(int joint, double k, double q_off) {
+  if (!std::isfinite(k) || !std::isfinite(q_off)) {
+    throw Error("the gravity of joint " + std::to_string(joint + 1) +
+                " (k, qoff) is not finite; give a result of dynid identify --model gravity");
+  }
+  JointGravityModel g;
+  g.joint_ = joint;
+  g.k_ = k;
+  g.q_off_ = q_off;
+  return g;
+}
+
+JointGravityModel JointGravityModel::poses(const Model& model, int joint,
+                                           const std::vector<std::string>& names,
+                                           const Eigen::VectorXd& values) {
+  if (joint < 0 || joint >= model.dof()) {
+    throw Error("joint " + std::to_string(joint + 1) + " is not a joint of model '" + model.name +
+                "'");
+  }
+  const BaseParameters base = gravity_row_base(model, joint);
+  if (base.names != names || values.size() != static_cast<Eigen::Index>(names.size()) ||
+      !values.allFinite()) {
+    throw Error("the gravity parameters given are not those of joint " + std::to_string(joint + 1) +
+                " of model '" + model.name +
+                "' (expected the names dynid identify --model gravity writes for it)");
+  }
+  JointGravityModel g;
+  g.joint_ = joint;
+  g.model_ = std::make_shared<const Model>(model);
+  const auto columns = static_cast<Eigen::Index>(kLinkParams * model.dof());
+  // base.select() maps rows over the link columns to the base columns (base + K_d·dependent).
+  g.select_ = base.select(Eigen::MatrixXd::Identity(columns, columns));
+  g.theta_ = values;
+  return g;
+}
+
+double JointGravityModel::torque(const Eigen::VectorXd& q) const {
+  if (!model_) return k_ * std::sin(q[joint_] + q_off_);
+  GravityRow row(*model_, joint_);
+  return (row(q) * select_ * theta_)(0);
+}
 
 GravityPosesResult fit_gravity_poses(const Model& model, const std::vector<ProcessedRecord>& runs,
                                      int joint, const GravityExperimentOptions& options) {
@@ -296,21 +362,11 @@ GravityPosesResult fit_gravity_poses(const Model& model, const std::vector<Proce
   }
   const std::string jn = std::to_string(joint + 1);
   GravityRow gravity_row(model, joint);
-  // The structural gravity base parameters of row J: its link columns sampled at random poses,
-  // classified left to right (so MX, MY, MZ lead and masses regroup into them).
-  const std::vector<std::string> link_names = ParameterLayout::rigid().names(n);
-  constexpr int kPoses = 200;
-  std::mt19937 rng(20261130);
+  const BaseParameters base = gravity_row_base(model, joint);
+  // The random poses of the diagnosis below continue the stream gravity_row_base() drew from.
+  std::mt19937 rng(kGravityPoseSeed);
   std::uniform_real_distribution<double> angle(-3.14159265358979323846, 3.14159265358979323846);
-  Eigen::MatrixXd random_rows(kPoses, kLinkParams * n);
-  for (int s = 0; s < kPoses; ++s) {
-    Eigen::VectorXd q(n);
-    for (int i = 0; i < n; ++i) q[i] = angle(rng);
-    random_rows.row(s) = gravity_row(q);
-  }
-  BaseParameterOptions bo;
-  bo.layout = ParameterLayout::rigid();
-  const BaseParameters base = classify_columns(random_rows, link_names, bo);
+  for (int s = 0; s < kGravityPoses * n; ++s) angle(rng);
   const int rg = base.rank;
   if (rg == 0) {
     throw Error("gravity exerts no torque on joint " + jn + " of '" + model.name +

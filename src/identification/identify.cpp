@@ -136,9 +136,10 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
   const bool closed = options.closed_loop.method != ClosedLoopMethod::kNone;
   const bool ml = options.estimator == IdentificationEstimator::kMl;
   check_closed_loop_request(options, runs.size(), references.size());
-  Eigen::Index projected_dimensions = 0;  // Σ over runs and joints of the projector's rank
-  std::vector<ProcessedRecord> prepared;  // every run's (maximum likelihood needs them all)
-  ProjectedRun projected;                 // the first run's projection (maximum likelihood)
+  Eigen::Index projected_dimensions = 0;       // Σ over runs and joints of the projector's rank
+  std::vector<ProcessedRecord> prepared;       // every run's (maximum likelihood needs them all)
+  ProjectedRun projected;                      // the first run's projection (maximum likelihood)
+  std::vector<Eigen::VectorXd> remainder_std;  // per closed-loop run, per joint [N·m or N]
   if (integral) {
     std::ostringstream m;
     m << "integral (energy) model, "
@@ -170,6 +171,7 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
       subtract_known_friction(model, options.known_friction, processed, raw);
       blocks.push_back(project_equations(raw, *cl.projector));
       projected_dimensions += static_cast<Eigen::Index>(n) * cl.report.rank;
+      remainder_std.push_back(cl.torque_remainder_std);
       if (i == 0) {
         projected.projector = cl.projector;
         projected.torque_remainder_std = cl.torque_remainder_std;
@@ -282,15 +284,23 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
     so.names = W.columns;
     // Channel of each row: run × joint, the projected series the clustered sandwich sums over.
     Eigen::VectorXi channel(W.y.size());
+    Eigen::VectorXd remainder_variance(W.y.size());
     Eigen::Index at = 0;
     for (size_t b = 0; b < blocks.size(); ++b) {
       const Eigen::Index rows = blocks[b].y.size();
       channel.segment(at, rows) = W.group.segment(at, rows).array() + static_cast<int>(b) * n;
+      for (Eigen::Index i = at; i < at + rows; ++i) {
+        const Eigen::VectorXd& r = remainder_std[b];
+        remainder_variance[i] = r.size() == n ? r[W.group[i]] * r[W.group[i]] : NAN;
+      }
       at += rows;
     }
-    fit.covariance_choice =
-        projected_statistics(fit.estimate, W, projected_dimensions,
-                             options.estimator == IdentificationEstimator::kWls, so, channel);
+    fit.covariance_choice = projected_statistics(fit.estimate, W, projected_dimensions,
+                                                 options.estimator == IdentificationEstimator::kWls,
+                                                 so, channel, remainder_variance);
+    result.interval_source = fit.estimate.covariance_kind == "torque remainder, projected"
+                                 ? "torque_remainder"
+                                 : "projected_residual";
   }
   if (ml) {
     projected.dimensions = projected_dimensions;

@@ -14,8 +14,14 @@ namespace dynid {
 ValidationResult validate_torques(const Model& model, const JointRecord& record,
                                   const std::vector<std::string>& names,
                                   const Eigen::VectorXd& values, const IdentifyOptions& options,
-                                  const std::vector<std::string>& not_excited) {
+                                  const std::vector<std::string>& not_excited,
+                                  const ParameterCompletion& nominal) {
   const int n = model.dof();
+  if (nominal.values.size() != static_cast<Eigen::Index>(nominal.names.size())) {
+    throw Error("validate_torques: the nominal completion has " +
+                std::to_string(nominal.names.size()) + " names and " +
+                std::to_string(nominal.values.size()) + " values");
+  }
   ValidationResult out;
   out.processed = preprocess_run(model, record, options.signal, out.choices);
   // As identify() does: a joint held by its controller did not move (its jitter is noise).
@@ -49,18 +55,14 @@ ValidationResult validate_torques(const Model& model, const JointRecord& record,
     determined.push_back(column_of(names[i]));
     theta[determined.back()] = values[static_cast<Eigen::Index>(i)];
   }
-  const Eigen::VectorXd pred = all.W * theta;
   const Eigen::Index m = r.t.size();
   out.samples = m;
-  out.predicted =
-      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-          pred.data(), m, n);
   const Eigen::VectorXd threshold =
       zero_velocity_threshold(options.layout, options.signal, out.processed,
                               "left out of the error statistics", out.choices);
   out.zero_velocity_threshold = threshold;
-  const Eigen::MatrixXd e = r.tau - out.predicted;
   const EquationBlock moving = moving_rows(all, r.dq, threshold);
+  Eigen::VectorXd pred = all.W * theta;
   if (!not_excited.empty() && moving.y.size() > 0) {
     std::vector<int> together = determined;
     for (const std::string& name : not_excited) together.push_back(column_of(name));
@@ -70,12 +72,39 @@ ValidationResult validate_torques(const Model& model, const JointRecord& record,
         data_identifiability(select_columns(moving, determined)).rank) {
       std::string list;
       for (const std::string& name : not_excited) list += (list.empty() ? "" : ", ") + name;
-      throw Error("the result does not determine " + list +
-                  " (not_excited: its identification data did not move them) but this run "
-                  "excites them, so its torques cannot be predicted; validate on a run like the "
-                  "identification run(s), or identify from runs that also excite those");
+      if (nominal.names.empty()) {
+        throw Error("the result does not determine " + list +
+                    " (not_excited: its identification data did not move them) but this run "
+                    "excites them, and no nominal values were given to predict them with; "
+                    "validate on a run like the identification run(s), or identify from runs "
+                    "that also excite those");
+      }
+      // The estimates hold D·θ_u (data regrouping); with θ_u at its nominal value the completed
+      // vector predicts the identification data as the estimates do, and this run too.
+      theta.setZero();
+      for (size_t i = 0; i < nominal.names.size(); ++i) {
+        theta[column_of(nominal.names[i])] = nominal.values[static_cast<Eigen::Index>(i)];
+      }
+      const Eigen::VectorXd filled = all.W * theta;
+      out.filled_share = (filled - pred).norm() / std::max(filled.norm(), 1e-300);
+      pred = filled;
+      out.completed = not_excited;
+      std::ostringstream share;
+      share.precision(3);
+      share << 100.0 * out.filled_share;
+      out.warnings.push_back(
+          "the result does not determine " + list +
+          " (not excited by its identification data) but this run excites them: predicted with "
+          "their nominal (model) values, which carry " +
+          share.str() +
+          " % of the predicted torque; identify from runs that also excite those to predict "
+          "them from data");
     }
   }
+  out.predicted =
+      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+          pred.data(), m, n);
+  const Eigen::MatrixXd e = r.tau - out.predicted;
   const Eigen::VectorXd e_moving = moving.y - moving.W * theta;
   Eigen::VectorXd e2 = Eigen::VectorXd::Zero(n), y2 = Eigen::VectorXd::Zero(n),
                   cnt = Eigen::VectorXd::Zero(n);

@@ -490,6 +490,12 @@ LoadIdentificationResult identify_load(const EquationBlock& block,
     if (flagged[j]) out.not_excited.push_back(out.names[j]);
   }
   const bool with_inertia = std::find(out.names.begin(), out.names.end(), "Ixx") != out.names.end();
+  // Standing poses (the static model) carry no inertia column: the six inertias are not excited,
+  // and are named so, as identify names what its data leave undetermined (issue 25 item 8).
+  if (!with_inertia) {
+    for (const char* name : {"Ixx", "Ixy", "Ixz", "Iyy", "Iyz", "Izz"})
+      out.not_excited.emplace_back(name);
+  }
   out.physics = load_physics(e.x, with_inertia);
   return out;
 }

@@ -119,25 +119,39 @@ void log_cholesky_from_link(const Eigen::Ref<const Eigen::VectorXd>& link, doubl
 struct DataCost {
   const ParameterMap& map;
   const BaseParameters& base;
-  Eigen::MatrixXd L_inv;  // C = L·Lᵀ
-  Eigen::VectorXd theta_b;
+  Eigen::MatrixXd L_inv;     // C = L·Lᵀ
+  Eigen::VectorXd theta_b;   // the estimate, k values
+  Eigen::MatrixXd observed;  // k × rank; empty: the identity
 
   template <typename T>
   bool operator()(T const* const* phi, T* residual) const {
     std::vector<T> theta(static_cast<size_t>(map.size()));
     map(phi[0], theta.data());
-    std::vector<T> diff(static_cast<size_t>(base.rank));
+    std::vector<T> reduced(static_cast<size_t>(base.rank));
     for (int i = 0; i < base.rank; ++i) {
       T v = theta[static_cast<size_t>(base.base[i])];
       for (size_t j = 0; j < base.dependent.size(); ++j) {
         v += base.K_d(i, static_cast<Eigen::Index>(j)) *
              theta[static_cast<size_t>(base.dependent[j])];
       }
+      reduced[static_cast<size_t>(i)] = v;
+    }
+    const auto k = static_cast<int>(theta_b.size());
+    std::vector<T> diff(static_cast<size_t>(k));
+    for (int i = 0; i < k; ++i) {
+      if (observed.size() == 0) {
+        diff[static_cast<size_t>(i)] = reduced[static_cast<size_t>(i)] - theta_b[i];
+        continue;
+      }
+      T v(0);
+      for (int b = 0; b < base.rank; ++b) {
+        if (observed(i, b) != 0.0) v += observed(i, b) * reduced[static_cast<size_t>(b)];
+      }
       diff[static_cast<size_t>(i)] = v - theta_b[i];
     }
-    for (int i = 0; i < base.rank; ++i) {
+    for (int i = 0; i < k; ++i) {
       residual[i] = T(0);
-      for (int k = 0; k <= i; ++k) residual[i] += L_inv(i, k) * diff[static_cast<size_t>(k)];
+      for (int c = 0; c <= i; ++c) residual[i] += L_inv(i, c) * diff[static_cast<size_t>(c)];
     }
     return true;
   }
@@ -190,7 +204,8 @@ class StallCallback : public ceres::IterationCallback {
 PhysicalFit physical_parameters(const Model& nominal, const BaseParameters& base,
                                 const ParameterLayout& layout, const Eigen::VectorXd& theta_b,
                                 const Eigen::MatrixXd& covariance,
-                                const PhysicalFitOptions& options) {
+                                const PhysicalFitOptions& options,
+                                const Eigen::MatrixXd& observed) {
   const int n = nominal.dof();
   ParameterMap map;
   map.links = n;
@@ -198,8 +213,9 @@ PhysicalFit physical_parameters(const Model& nominal, const BaseParameters& base
   for (int j = 0; j < n; ++j)
     map.nonnegative.insert(map.nonnegative.end(), per_joint.begin(), per_joint.end());
   map.extra = static_cast<int>(base.layout_names.size()) - layout.columns(n);
-  if (map.extra < 0 || theta_b.size() != base.rank || covariance.rows() != base.rank ||
-      covariance.cols() != base.rank) {
+  const Eigen::Index k = observed.size() == 0 ? base.rank : observed.rows();
+  if (map.extra < 0 || theta_b.size() != k || covariance.rows() != k || covariance.cols() != k ||
+      (observed.size() != 0 && observed.cols() != base.rank)) {
     throw Error("physical parameters: the base set (" + std::to_string(base.rank) +
                 " parameters) does not match the estimate (" + std::to_string(theta_b.size()) +
                 ") or its covariance; identify and fit with the same model and friction options");
@@ -238,7 +254,16 @@ PhysicalFit physical_parameters(const Model& nominal, const BaseParameters& base
   }
   Eigen::VectorXd start_theta = theta_nom;
   for (int i = 0; i < base.rank; ++i) {
-    if (base.base[i] >= 10 * n) start_theta[base.base[i]] = theta_b[i];
+    if (base.base[i] < 10 * n) continue;
+    if (observed.size() == 0) {
+      start_theta[base.base[i]] = theta_b[i];
+      continue;
+    }
+    // With data regroupings: the estimate of a kept joint term that holds itself alone.
+    for (Eigen::Index r = 0; r < k; ++r) {
+      if (observed(r, i) == 1.0 && observed.row(r).cwiseAbs().sum() == 1.0)
+        start_theta[base.base[i]] = theta_b[r];
+    }
   }
   for (int c = 10 * n; c < P; ++c) {
     const bool positive = c - 10 * n < static_cast<int>(map.nonnegative.size()) &&
@@ -264,9 +289,9 @@ PhysicalFit physical_parameters(const Model& nominal, const BaseParameters& base
   auto* data = new ceres::DynamicAutoDiffCostFunction<DataCost, 4>(new DataCost{
       map, base,
       L.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(base.rank, base.rank)),
-      theta_b});
+      theta_b, observed});
   data->AddParameterBlock(P);
-  data->SetNumResiduals(base.rank);
+  data->SetNumResiduals(static_cast<int>(k));
   problem.AddResidualBlock(data, nullptr, phi.data());
   auto* prior = new ceres::DynamicAutoDiffCostFunction<PriorCost, 4>(
       new PriorCost{map, start_theta, scale / std::sqrt(options.prior_weight)});
@@ -305,9 +330,11 @@ PhysicalFit physical_parameters(const Model& nominal, const BaseParameters& base
     throw Error("physical parameters: the fit diverged (" + cs.message + ")");
   }
   out.theta_b = base.reduce(out.theta);
-  out.mahalanobis = (L.triangularView<Eigen::Lower>().solve(out.theta_b - theta_b)).norm();
-  out.chi2_limit = std::sqrt(boost::math::quantile(
-      boost::math::chi_squared(static_cast<double>(base.rank)), options.confidence_level));
+  const Eigen::VectorXd fitted = observed.size() == 0 ? out.theta_b : observed * out.theta_b;
+  out.mahalanobis = (L.triangularView<Eigen::Lower>().solve(fitted - theta_b)).norm();
+  out.chi2_limit = std::sqrt(boost::math::quantile(boost::math::chi_squared(static_cast<double>(k)),
+                                                   options.confidence_level));
+  out.within_limit = out.mahalanobis <= out.chi2_limit;
   const Eigen::VectorXd d_links = out.theta.head(10 * n) - theta_nom.head(10 * n);
   out.nominal_distance = d_links.norm() / std::max(theta_nom.head(10 * n).norm(), 1e-300);
   out.min_pseudo_inertia_eigenvalue.resize(n);
@@ -326,7 +353,7 @@ PhysicalFit physical_parameters(const Model& nominal, const BaseParameters& base
   }
   out.iterations = static_cast<int>(cs.iterations.size());
   out.converged = cs.termination_type == ceres::CONVERGENCE || stall.stalled();
-  if (out.mahalanobis > out.chi2_limit) {
+  if (!out.within_limit && options.refuse_beyond_limit) {
     std::ostringstream m;
     m.precision(3);
     m << "no physically consistent parameter set lies near the identified values: the nearest is "
@@ -343,24 +370,56 @@ PhysicalCheck physical_parameters_of_result(const Model& model, const Identifica
                                             const IdentifyOptions& options, const JointRecord& run,
                                             const std::string& option,
                                             std::optional<double> free_error) {
-  // A parameter the data did not determine has no meaningful σ: the χ² test against the
-  // estimate would accept any value for it.
-  if (!result.not_excited.empty())
-    throw Error(option +
-                " needs every base parameter determined by the data; these are not excited: " +
-                result.not_excited.front() + (result.not_excited.size() > 1 ? " and others" : "") +
-                " (record a run that moves every joint)");
+  // A parameter the data did not determine has no σ of its own: the estimates observe the kept
+  // base parameters plus their data regroupings, θ̂_k = θ_k + D·θ_u, and the consistent set is
+  // fitted to that; θ_u then follows the pull towards the nominal model.
   PhysicalCheck out;
+  Eigen::MatrixXd observed;
+  if (!result.not_excited.empty()) {
+    const auto index_of = [&](const std::string& name) {
+      const auto it = std::find(result.base.names.begin(), result.base.names.end(), name);
+      if (it == result.base.names.end())
+        throw Error(option + ": '" + name + "' is not a base parameter of the result's model");
+      return static_cast<Eigen::Index>(it - result.base.names.begin());
+    };
+    const auto kept = static_cast<Eigen::Index>(result.names.size());
+    observed = Eigen::MatrixXd::Zero(kept, result.base.rank);
+    for (Eigen::Index i = 0; i < kept; ++i)
+      observed(i, index_of(result.names[static_cast<size_t>(i)])) = 1.0;
+    for (size_t u = 0; u < result.not_excited.size(); ++u) {
+      const Eigen::Index b = index_of(result.not_excited[u]);
+      for (Eigen::Index i = 0; i < std::min(kept, result.data_regrouping.rows()); ++i)
+        observed(i, b) += result.data_regrouping(i, static_cast<Eigen::Index>(u));
+    }
+    out.warnings.push_back(
+        "not excited by the data, so set by the consistent model nearest the nominal one: " + [&] {
+          std::string list;
+          for (const auto& name : result.not_excited) list += (list.empty() ? "" : ", ") + name;
+          return list;
+        }());
+  }
   out.fit = physical_parameters(model, result.base, options.layout, result.estimate.x,
-                                result.estimate.covariance);
+                                result.estimate.covariance, {}, observed);
   IdentifyOptions same = options;
   same.signal.cutoff_hz = result.processed.cutoff_hz;
   out.physical_error =
-      validate_torques(model, run, result.names, out.fit.theta_b, same).relative_error_all;
-  out.free_error =
-      free_error
-          ? *free_error
-          : validate_torques(model, run, result.names, result.estimate.x, same).relative_error_all;
+      validate_torques(model, run, result.base.names, out.fit.theta_b, same).relative_error_all;
+  out.free_error = free_error ? *free_error
+                              : validate_torques(model, run, result.names, result.estimate.x, same,
+                                                 result.not_excited)
+                                    .relative_error_all;
+  if (!out.fit.within_limit) {
+    std::ostringstream m;
+    m.precision(3);
+    m << "the nearest physically consistent parameter set is " << out.fit.mahalanobis
+      << " sigma from the estimate (limit " << out.fit.chi2_limit
+      << "): beyond what the intervals allow, the model lacks a term the data need (friction, a "
+         "coupling, a payload) or the intervals are too narrow; it is returned with its torque "
+         "error, "
+      << 100.0 * out.physical_error << " % against " << 100.0 * out.free_error
+      << " % unconstrained";
+    out.warnings.push_back(m.str());
+  }
   return out;
 }
 

@@ -175,7 +175,8 @@ nlohmann::json decoupled_model_to_json(const Model& model, const DecoupledJointR
 }
 
 void physical_parameters_to_json(const PhysicalFit& fit, double relative_error,
-                                 double relative_error_unconstrained, nlohmann::json& result) {
+                                 double relative_error_unconstrained, nlohmann::json& result,
+                                 const std::vector<std::string>& warnings) {
   nlohmann::json list = nlohmann::json::array();
   for (size_t i = 0; i < fit.names.size(); ++i) {
     list.push_back(
@@ -185,24 +186,32 @@ void physical_parameters_to_json(const PhysicalFit& fit, double relative_error,
   result["physically_consistent"] = fit.consistent;
   result["physical"] = {
       {"mahalanobis", json_number(fit.mahalanobis)},
+      {"distance_sigma", json_number(fit.mahalanobis)},
       {"chi2_limit", json_number(fit.chi2_limit)},
+      {"within_limit", fit.within_limit},
       {"nominal_distance", json_number(fit.nominal_distance)},
       {"converged", fit.converged},
       {"iterations", fit.iterations},
       {"relative_error", json_number(relative_error)},
       {"relative_error_unconstrained", json_number(relative_error_unconstrained)},
-      {"min_pseudo_inertia_eigenvalue", numbers(fit.min_pseudo_inertia_eigenvalue)}};
+      {"min_pseudo_inertia_eigenvalue", numbers(fit.min_pseudo_inertia_eigenvalue)},
+      {"warnings", warnings}};
+  if (!result.contains("warnings") || !result["warnings"].is_array())
+    result["warnings"] = nlohmann::json::array();
+  for (const std::string& w : warnings) result["warnings"].push_back(w);
 }
 
 std::string physical_parameters_text(const PhysicalFit& fit, double relative_error,
                                      double relative_error_unconstrained) {
   char buf[400];
-  std::snprintf(buf, sizeof(buf),
-                "physically consistent parameters: %s, %.3g sigma from the estimate (limit %.3g), "
-                "torque error %.2f %% against %.2f %% unconstrained%s\n",
-                fit.consistent ? "found" : "NOT found", fit.mahalanobis, fit.chi2_limit,
-                100.0 * relative_error, 100.0 * relative_error_unconstrained,
-                fit.converged ? "" : " (the fit stopped at its iteration limit)");
+  std::snprintf(
+      buf, sizeof(buf),
+      "physically consistent parameters: %s, %.3g sigma from the estimate (limit %.3g%s), "
+      "torque error %.2f %% against %.2f %% unconstrained%s\n",
+      fit.consistent ? "found" : "NOT found", fit.mahalanobis, fit.chi2_limit,
+      fit.within_limit ? "" : ", exceeded", 100.0 * relative_error,
+      100.0 * relative_error_unconstrained,
+      fit.converged ? "" : " (the fit stopped at its iteration limit)");
   return buf;
 }
 

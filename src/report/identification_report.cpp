@@ -103,36 +103,38 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
     for (Eigen::Index i = 0; i < m.rows(); ++i) out.push_back(numbers(m.row(i).transpose()));
     return out;
   };
-  return {{"model",
-           {{"name", model.name},
-            {"source", model.source},
-            {"dof", model.dof()},
-            {"joints", joint_names(model)}}},
-          {"parameters", params},
-          {"covariance_matrix", rows(e.covariance)},
-          {"data_regrouping",
-           r.not_excited.empty() ? nlohmann::json::array() : rows(r.data_regrouping)},
-          {"confidence_level", e.confidence_level},
-          {"rank", r.rank},
-          {"data_rank", r.data_rank},
-          {"not_excited", r.not_excited},
-          {"runs", runs},
-          {"excitation", excitation},
-          {"condition_number", json_number(r.condition_number)},
-          {"samples", r.samples},
-          {"rows", r.rows},
-          {"residual_rms", numbers(r.residual_rms)},
-          {"joint_relative_error", numbers(r.joint_relative_error)},
-          {"residual_autocorrelation", numbers(r.residual_autocorrelation)},
-          {"relative_error", json_number(r.relative_error)},
-          {"zero_velocity_threshold", numbers(r.zero_velocity_threshold)},
-          {"residual_variance", json_number(e.residual_variance)},
-          {"estimator", to_string(e.summary.estimator)},
-          {"unidentifiable", r.unidentifiable},
-          {"warnings", r.warnings},
-          {"choices", choices},
-          {"options", options_used},
-          {"version", kVersion}};
+  nlohmann::json out = {{"model",
+                         {{"name", model.name},
+                          {"source", model.source},
+                          {"dof", model.dof()},
+                          {"joints", joint_names(model)}}},
+                        {"parameters", params},
+                        {"covariance_matrix", rows(e.covariance)},
+                        {"data_regrouping",
+                         r.not_excited.empty() ? nlohmann::json::array() : rows(r.data_regrouping)},
+                        {"confidence_level", e.confidence_level},
+                        {"rank", r.rank},
+                        {"data_rank", r.data_rank},
+                        {"not_excited", r.not_excited},
+                        {"runs", runs},
+                        {"excitation", excitation},
+                        {"condition_number", json_number(r.condition_number)},
+                        {"samples", r.samples},
+                        {"rows", r.rows},
+                        {"residual_rms", numbers(r.residual_rms)},
+                        {"joint_relative_error", numbers(r.joint_relative_error)},
+                        {"residual_autocorrelation", numbers(r.residual_autocorrelation)},
+                        {"relative_error", json_number(r.relative_error)},
+                        {"zero_velocity_threshold", numbers(r.zero_velocity_threshold)},
+                        {"residual_variance", json_number(e.residual_variance)},
+                        {"estimator", to_string(e.summary.estimator)},
+                        {"unidentifiable", r.unidentifiable},
+                        {"warnings", r.warnings},
+                        {"choices", choices},
+                        {"options", options_used},
+                        {"version", kVersion}};
+  if (!r.interval_source.empty()) out["interval_source"] = r.interval_source;
+  return out;
 }
 
 std::string identification_table(const Model& model, const IdentificationResult& r) {
@@ -315,6 +317,18 @@ IdentifiedResultFile identification_result_from_json(const nlohmann::json& j,
                   "dynid identify");
     }
   }
+  const auto experiment = j.find("experiment");
+  if (experiment != j.end() && experiment->is_string()) {
+    out.experiment = experiment->get<std::string>();
+    const auto joint = j.find("joint");
+    if (joint == j.end() || !joint->is_number_integer() || joint->get<int>() < 1) {
+      throw Error("'" + path +
+                  "': an experiment result needs its 1-based 'joint'; write the file "
+                  "with dynid identify --model " +
+                  out.experiment);
+    }
+    out.experiment_joint = joint->get<int>();
+  }
   return out;
 }
 
@@ -382,6 +396,9 @@ nlohmann::json validation_to_json(const Model& model, const ValidationResult& v)
              "keep every row"},
             {"zero_velocity_threshold", numbers(v.zero_velocity_threshold)},
             {"rows", v.rows_excluded}}},
+          {"completed", v.completed},
+          {"filled_share", json_number(v.filled_share)},
+          {"warnings", v.warnings},
           {"choices", choices},
           {"version", kVersion}};
 }

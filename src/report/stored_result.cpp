@@ -130,7 +130,8 @@ void add_stored_known_friction(const IdentifiedResultFile& identified, const std
 }
 
 CompletedModel completed_model_of_result(const Model& model, const IdentifiedResultFile& identified,
-                                         const std::string& path) {
+                                         const std::string& path,
+                                         const ModelCompletionOptions& completion) {
   IdentifyOptions options;
   try {
     options.layout = stored_layout(ResultFileOptions{identified.options, path});
@@ -142,7 +143,53 @@ CompletedModel completed_model_of_result(const Model& model, const IdentifiedRes
   add_stored_known_friction(identified, path, model, names, values, options);
   return complete_identified_model(model, names, values, identified.std_devs,
                                    identified.not_excited, identified.data_regrouping,
-                                   identified.covariance, options);
+                                   identified.covariance, options, completion);
+}
+
+ParameterCompletion nominal_completion_of_result(const Model& model,
+                                                 const IdentifiedResultFile& identified,
+                                                 const std::string& path) {
+  ParameterCompletion out;
+  if (identified.not_excited.empty()) return out;
+  ModelCompletionOptions only_not_excited;
+  only_not_excited.max_relative_std = 0.0;
+  const CompletedModel c = completed_model_of_result(model, identified, path, only_not_excited);
+  out.names = c.names;
+  out.values = c.values;
+  return out;
+}
+
+void add_stored_friction_compensation(const Model& model, const IdentifiedResultFile& identified,
+                                      const std::string& path, int joint,
+                                      FrictionExperimentOptions& options) {
+  if (identified.experiment.empty()) return;
+  const std::string jn = std::to_string(joint + 1);
+  if (identified.experiment != "gravity" && identified.experiment != "decoupled") {
+    throw Error("'" + path + "' is a --model " + identified.experiment +
+                " result; compensate a friction experiment with a result of identify (the "
+                "differential or integral model), --model gravity or --model decoupled");
+  }
+  if (identified.experiment_joint != joint + 1) {
+    throw Error("'" + path + "' is the " + identified.experiment + " result of joint " +
+                std::to_string(identified.experiment_joint) + "; give the one of joint " + jn);
+  }
+  const auto value = [&](const std::string& name) {
+    const auto it = std::find(identified.names.begin(), identified.names.end(), name);
+    if (it == identified.names.end())
+      throw Error("'" + path + "' has no parameter '" + name +
+                  "'; write it with dynid identify "
+                  "--model " +
+                  identified.experiment);
+    return identified.values[it - identified.names.begin()];
+  };
+  const bool sinusoid = std::find(identified.names.begin(), identified.names.end(), "k" + jn) !=
+                        identified.names.end();
+  if (sinusoid) {
+    options.gravity = JointGravityModel::sinusoid(joint, value("k" + jn), value("qoff" + jn));
+  } else {
+    options.gravity = JointGravityModel::poses(model, joint, identified.names, identified.values);
+  }
+  if (identified.experiment == "decoupled") options.equivalent_inertia = value("M" + jn);
 }
 
 nlohmann::json parameter_sources_json(const CompletedModel& c) {

@@ -175,5 +175,39 @@ TEST(ClosedLoopCli, BadInputIsOneErrorLine) {
                "error: qr1 does not repeat with --period 3 s");
 }
 
+// Issue 25 item 3's case through the binary: a plain-PID 3-joint arm (irp6, native plant) on a
+// 3-harmonic reference over 3 periods projects onto 21 dimensions for 27 base parameters, and
+// identify refused ("no degrees of freedom are left for the intervals"). Now both methods return
+// the estimate with intervals from the torque remainder, say so in `interval_source` and a
+// warning, and validate accepts the result.
+TEST(ClosedLoopCli, NoIntervalDegreesOfFreedomLeftIsAWarningNotARefusal) {
+  auto r =
+      run("excite --robot irp6 --harmonics 3 --f0 0.2 --seed 2 --starts 1 --max-time 2 "
+          "--rate 200 --out " +
+          path("irp6_ref3.csv"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("simulate --robot irp6 --engine native --controller pid --trajectory " +
+          path("irp6_ref3.csv") + " --periods 3 --position-noise 1e-4 --torque-noise 0.5 --out " +
+          path("irp6_run3.csv"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const std::string method : {"projection", "spectral"}) {
+    const std::string out = path("irp6_" + method + ".json");
+    r = run("identify --robot irp6 --data " + path("irp6_run3.csv") + " --closed-loop " + method +
+            " --out " + out);
+    ASSERT_EQ(r.code, 0) << method << ": " << r.err;
+    EXPECT_NE(r.err.find("no degrees of freedom are left in the projected residual"),
+              std::string::npos)
+        << r.err;
+    const nlohmann::json j = load(out);
+    EXPECT_EQ(j["interval_source"], "torque_remainder") << method;
+    for (const auto& p : j["parameters"]) {
+      ASSERT_TRUE(p["std"].is_number()) << p.dump();
+      EXPECT_GT(p["std"].get<double>(), 0.0) << p.dump();
+    }
+    r = run("validate --robot irp6 --params " + out + " --data " + path("irp6_run3.csv"));
+    EXPECT_EQ(r.code, 0) << r.err;
+  }
+}
+
 }  // namespace
 }  // namespace dynid

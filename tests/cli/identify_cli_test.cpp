@@ -357,6 +357,54 @@ TEST(IdentifyCli, ParametersTheRunDoesNotExciteAreNamedNotEstimated) {
   EXPECT_NE(r.out.find("not excited"), std::string::npos) << r.out;
 }
 
+// Issue 25 item 2: a result that leaves Ia2 and Fv2 undetermined (joint 2 never moved) validates
+// a run that moves joint 2 with those two at their nominal values (the closed-form plant has
+// neither, like the built-in planar2), warns which, and says so in the JSON; it used to refuse.
+TEST(IdentifyCli, ValidateFillsWhatTheResultDoesNotDetermineFromTheNominalModel) {
+  const std::string out = ::testing::TempDir() + "/planar2_still_for_validate.json";
+  ASSERT_EQ(run("identify --robot planar2 --data " + planar2_joint2_still() +
+                " --friction viscous --filter none --out " + out)
+                .code,
+            0);
+  const std::string json = ::testing::TempDir() + "/planar2_validate_filled.json";
+  const CliRun v = run("validate --robot planar2 --params " + out + " --data " + planar2_run() +
+                       " --json " + json);
+  ASSERT_EQ(v.code, 0) << v.err;
+  EXPECT_NE(v.err.find("warning: validate: the result does not determine Ia2, Fv2"),
+            std::string::npos)
+      << v.err;
+  const auto j = load(json);
+  EXPECT_EQ(j["completed"], nlohmann::json::array({"Ia2", "Fv2"}));
+  EXPECT_GE(j["filled_share"].get<double>(), 0.0);
+  EXPECT_LT(j["filled_share"].get<double>(), 1.0);
+  // Exact closed-form torques with 6 significant digits: the completed model is the plant.
+  EXPECT_LT(j["relative_error_all_rows"].get<double>(), 1e-4) << j.dump();
+}
+
+// Issue 25 item 6: --physical on a result that leaves Ia2 and Fv2 undetermined (joint 2 never
+// moved) used to refuse ("record a run that moves every joint"), so export could export nothing.
+// Now the consistent set is fitted to what the data determine, with its distance in σ, and the
+// result exports.
+TEST(IdentifyCli, PhysicalFitsAResultWithParametersNotExcitedAndExportsIt) {
+  const std::string out = ::testing::TempDir() + "/planar2_still_physical.json";
+  const CliRun r = run("identify --robot planar2 --data " + planar2_joint2_still() +
+                       " --friction viscous --filter none --physical --out " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: --physical: not excited by the data, so set by the consistent "
+                       "model nearest the nominal one: Ia2, Fv2"),
+            std::string::npos)
+      << r.err;
+  const auto j = load(out);
+  EXPECT_TRUE(j["physically_consistent"].get<bool>());
+  EXPECT_TRUE(j["physical"]["within_limit"].get<bool>()) << j["physical"].dump();
+  EXPECT_LT(j["physical"]["distance_sigma"].get<double>(),
+            j["physical"]["chi2_limit"].get<double>());
+  const std::string urdf = ::testing::TempDir() + "/planar2_still_physical.urdf";
+  const CliRun e = run("export --robot planar2 --params " + out + " --out " + urdf);
+  EXPECT_EQ(e.code, 0) << e.err;
+  EXPECT_TRUE(std::ifstream(urdf).good());
+}
+
 TEST(IdentifyCli, RlsHistoryIsWrittenAndNeedsRls) {
   const std::string data = planar2_run();
   const std::string out = ::testing::TempDir() + "/planar2_rls.json";

@@ -142,6 +142,59 @@ TEST(IdentifyModelsCli, FrictionAndDecoupledModelsRunAndNameTheirParameters) {
   EXPECT_FALSE(std::filesystem::exists(bad));
 }
 
+// Issue 25 item 7, Bona & Curatella's chain (seed 2 §3.2): the friction runs are compensated with
+// the gravity the slopes identified. `--model friction --params` takes a `--model gravity` result
+// of the same joint (it was refused: "k1 is not a base parameter") and a `--model decoupled` one,
+// refuses one of another joint, and on a plant that is the nominal model gives the friction the
+// nominal compensation gives, to within their intervals (the identified gravity is the plant's).
+TEST(IdentifyModelsCli, FrictionIsCompensatedWithTheGravityOrDecoupledResultOfItsJoint) {
+  const std::string slopes = simulated(
+      "chain_slopes",
+      "--family slope --joint 1 --range -1.2:1.2 --velocity 0.6 --acceleration 2 --pose 0,0.5 "
+      "--cycles 1");
+  const std::string bang = simulated(
+      "chain_bang", "--family bang-bang --joint 1 --range -1:1 --acceleration 4 --pose 0,0.5");
+  const std::string gravity = (scratch() / "chain_gravity.json").string();
+  auto r = run("identify --robot planar2 --model gravity --joint 1 --data " + slopes +
+               " --torque-offset 0.0025 --out " + gravity);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string nominal = (scratch() / "chain_friction_nominal.json").string();
+  const std::string chained = (scratch() / "chain_friction_gravity.json").string();
+  r = run("identify --robot planar2 --model friction --joint 1 --data " + bang +
+          " --torque-offset 0.0025 --out " + nominal);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("identify --robot planar2 --model friction --joint 1 --data " + bang +
+          " --torque-offset 0.0025 --params " + gravity + " --out " + chained);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json fn = load(nominal), fg = load(chained);
+  EXPECT_NE(fg["choices"]["compensation"].get<std::string>().find("gravity identified"),
+            std::string::npos)
+      << fg["choices"].dump();
+  for (const char* name : {"Fvp1", "Fvn1", "Fcp1", "Fcn1"}) {
+    const double a = parameter(fn, name)["value"].get<double>();
+    const double b = parameter(fg, name)["value"].get<double>();
+    const double half = parameter(fn, name)["ci_high"].get<double>() - a +
+                        parameter(fg, name)["ci_high"].get<double>() - b;
+    EXPECT_NEAR(a, b, half) << name;
+  }
+  // The gravity of another joint is refused, naming both.
+  r = run("identify --robot planar2 --model friction --joint 2 --data " + bang + " --params " +
+          gravity + " --out " + (scratch() / "chain_bad.json").string());
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(testing::error_contract_problem(r.err), "") << r.err;
+  EXPECT_NE(r.err.find("gravity result of joint 1; give the one of joint 2"), std::string::npos)
+      << r.err;
+  // A decoupled result (equivalent inertia and gravity of the joint) compensates too.
+  const std::string decoupled = (scratch() / "chain_decoupled.json").string();
+  r = run("identify --robot planar2 --model decoupled --joint 1 --data " + bang +
+          " --torque-offset 0.0025 --out " + decoupled);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("identify --robot planar2 --model friction --joint 1 --data " + bang +
+          " --torque-offset 0.0025 --params " + decoupled + " --out " +
+          (scratch() / "chain_friction_decoupled.json").string());
+  EXPECT_EQ(r.code, 0) << r.err;
+}
+
 // The wiring of --model integral: same base parameters and names as the differential model, and a
 // result validate accepts. Whether the two models agree is the library's test
 // (tests/identification/integral_equations_test.cpp); on this short optimised run they do not (6 of

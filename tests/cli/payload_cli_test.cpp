@@ -141,6 +141,7 @@ TEST_F(PayloadCli, StaticPosesFromQuaternionsWithBiases) {
   }
   EXPECT_TRUE(j.at("inertia_com").is_null());
   EXPECT_TRUE(j.contains("not_reported"));
+  EXPECT_EQ(j.at("not_excited"), nlohmann::json::array({"Ixx", "Ixy", "Ixz", "Iyy", "Iyz", "Izz"}));
 }
 
 // A pose/IMU log without a robot model: quaternion, angular velocity and acceleration, linear

@@ -11,6 +11,7 @@
 #include "dynid/closed_loop/closed_loop.hpp"
 #include "dynid/closed_loop/maximum_likelihood.hpp"
 #include "dynid/identification/identify.hpp"
+#include "dynid/model/robots.hpp"
 #include "support/closed_loop_runs.hpp"
 #include "support/error_of.hpp"
 
@@ -29,6 +30,26 @@ ClosedRun plain_pid_run(const Model& m, unsigned seed, int periods, double q_noi
                         double tau_noise) {
   const TrajectorySamples tr =
       sample_trajectory(FourierTrajectory(testing::planar2_reference()), kRate, false);
+  SimulateOptions so = testing::noisy_sensors(q_noise, tau_noise, seed, periods + 1);
+  so.feed_forward = FeedForward::kNone;
+  so.plant.engine = PlantEngine::kNative;
+  const ClosedLoopResult r = simulate_reference(m, tr.t, tr.q, tr.dq, tr.ddq, so);
+  const Eigen::Index skip = tr.t.size(), rows = r.t.size() - skip;
+  ClosedRun out;
+  out.run = {r.t.tail(rows), r.q.bottomRows(rows), {}, {}, r.tau.bottomRows(rows)};
+  out.reference.qr = r.qr.bottomRows(rows);
+  return out;
+}
+
+// plain_pid_run() with a reference of `harmonics` ≤ 4 (the planar2 reference truncated).
+ClosedRun plain_pid_run_harmonics(const Model& m, unsigned seed, int periods, int harmonics,
+                                  double q_noise, double tau_noise) {
+  FourierCoefficients c = testing::planar2_reference();
+  for (int j = 0; j < 2; ++j) {
+    for (int h = harmonics; h < 4; ++h) c.a[static_cast<size_t>(j)][h] = 0.0;
+    for (int h = harmonics; h < 4; ++h) c.b[static_cast<size_t>(j)][h] = 0.0;
+  }
+  const TrajectorySamples tr = sample_trajectory(FourierTrajectory(c), kRate, false);
   SimulateOptions so = testing::noisy_sensors(q_noise, tau_noise, seed, periods + 1);
   so.feed_forward = FeedForward::kNone;
   so.plant.engine = PlantEngine::kNative;
@@ -249,6 +270,72 @@ TEST(ClosedLoopIdentification, BadReferencesAreClearErrors) {
             "--closed-loop spectral needs a periodic reference sampled a whole number of times "
             "per period, with at least two periods: qr does not repeat; use --closed-loop "
             "projection");
+}
+
+// Issue 25 item 3: a reference whose harmonics span no more projected dimensions than the model
+// has parameters (2 harmonics: 5 per channel, 10 in all, for 11) left no degrees of freedom in the
+// projected residual, and identify refused. The estimate exists; its intervals now take the
+// noise from the torque remainder outside the projected span (interval_source
+// "torque_remainder"). Over 3 seeds and both methods on the native RK4 plant (not the regressor)
+// the truth lies inside the 99.9 % intervals and the errors spread by 1.04 σ (rms z): intervals
+// of the right size. The plant has no friction here: with tanh Coulomb friction in the plant the
+// same runs put MX2 about 3 σ off on every seed alike (a bias, not noise: the band-limited sign of
+// the projected velocity, docs/methods/closed_loop.md), which no noise estimate can see when the
+// projected equations are fitted exactly.
+TEST(ClosedLoopIdentification, NoIntervalDegreesOfFreedomLeftStillGivesAnEstimate) {
+  const Model m = load_robot("planar2");
+  int outside = 0, total = 0;
+  double z2 = 0.0;
+  for (const ClosedLoopMethod method :
+       {ClosedLoopMethod::kProjection, ClosedLoopMethod::kSpectral}) {
+    for (unsigned seed : {410u, 411u, 412u}) {
+      const ClosedRun c = plain_pid_run_harmonics(m, seed, 3, 2, 2e-3, 0.3);
+      IdentifyOptions o = closed_options(method);
+      o.layout.coulomb = false;
+      const IdentificationResult r = identify(m, {c.run}, {c.reference}, o);
+      ASSERT_EQ(r.closed_loop.size(), 1u);
+      const Eigen::Index dims = 2 * r.closed_loop[0].rank;
+      ASSERT_LE(dims, r.data_rank) << "the case needs no spare projected dimension";
+      EXPECT_EQ(r.interval_source, "torque_remainder");
+      EXPECT_TRUE(r.estimate.std_dev.allFinite());
+      EXPECT_GT(r.estimate.std_dev.minCoeff(), 0.0);
+      bool warned = false;
+      for (const std::string& w : r.warnings)
+        warned |= w.find("torque remainder") != std::string::npos;
+      EXPECT_TRUE(warned);
+      // What the estimates stand for: their base parameters plus the data regrouping of the
+      // ones these two harmonics leave undetermined.
+      const Eigen::VectorXd theta_b = r.base.reduce(o.layout.parameters(m));
+      const auto base_value = [&](const std::string& name) {
+        return theta_b[std::find(r.base.names.begin(), r.base.names.end(), name) -
+                       r.base.names.begin()];
+      };
+      Eigen::VectorXd truth = truth_of(m, r, o.layout);
+      Eigen::VectorXd missing(static_cast<Eigen::Index>(r.not_excited.size()));
+      for (size_t u = 0; u < r.not_excited.size(); ++u)
+        missing[static_cast<Eigen::Index>(u)] = base_value(r.not_excited[u]);
+      if (missing.size() > 0) truth += r.data_regrouping * missing;
+      for (Eigen::Index i = 0; i < truth.size(); ++i) {
+        const bool out = truth[i] < r.estimate.ci_lower[i] || truth[i] > r.estimate.ci_upper[i];
+        outside += out;
+        const double z = (r.estimate.x[i] - truth[i]) / r.estimate.std_dev[i];
+        z2 += z * z;
+        if (out)
+          std::printf("seed %u: %s %.4g outside [%.4g, %.4g]\n", seed,
+                      r.names[static_cast<size_t>(i)].c_str(), truth[i], r.estimate.ci_lower[i],
+                      r.estimate.ci_upper[i]);
+      }
+      total += static_cast<int>(truth.size());
+    }
+  }
+  const double rms_z = std::sqrt(z2 / total);
+  std::printf(
+      "no interval degrees of freedom: %d of %d truths outside the 99.9 %% intervals, rms z %.3f\n",
+      outside, total, rms_z);
+  EXPECT_LE(outside, 2);
+  // Intervals of the right size, not merely wide: the errors in units of σ spread by about 1.
+  EXPECT_GT(rms_z, 0.4);
+  EXPECT_LT(rms_z, 2.0);
 }
 
 }  // namespace

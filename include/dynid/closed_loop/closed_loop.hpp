@@ -64,12 +64,19 @@ EquationBlock project_equations(const EquationBlock& block, const SignalProjecto
 /// the larger of the two (Angrist–Pischke 2009 §8.2.3), with the white correlations
 /// (C = S·C_white·S, S = diag(max(1, σ_cl/σ_white))): PSD, never narrower than the white one.
 /// Parameters widened by more than 20 % are named in a warning. docs/methods/closed_loop.md.
-/// Returns the one-line covariance choice. Throws dynid::Error when effective_rows ≤ the
-/// parameters or `channel` has the wrong size.
+/// When effective_rows ≤ the parameters the estimate still exists but its projected residual
+/// measures no noise (issue 25 item 3): `remainder_variance` (per row, the variance of its
+/// channel's torque remainder u − P·u, ClosedLoopRun::torque_remainder_std²) then gives the
+/// covariance B·(Σ_i σ_i²·w̃_i·w̃_iᵀ)·B (white noise across the band), covariance_kind
+/// "torque remainder, projected", with a warning that says so.
+/// Returns the one-line covariance choice. Throws dynid::Error when `channel` or
+/// `remainder_variance` has the wrong size, or when effective_rows ≤ the parameters without a
+/// usable remainder variance.
 std::string projected_statistics(Estimate& estimate, const EquationBlock& block,
                                  Eigen::Index effective_rows, bool weighted,
                                  const EstimationOptions& options,
-                                 const Eigen::VectorXi& channel = Eigen::VectorXi());
+                                 const Eigen::VectorXi& channel = Eigen::VectorXi(),
+                                 const Eigen::VectorXd& remainder_variance = Eigen::VectorXd());
 
 /// Refuses what identify() cannot do with options.closed_loop: another model than the
 /// differential one, or not one reference per run (none needed without a

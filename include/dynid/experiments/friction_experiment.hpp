@@ -1,5 +1,7 @@
 #pragma once
 
+#include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -7,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "dynid/estimation/estimate.hpp"
+#include "dynid/experiments/gravity_experiment.hpp"
 #include "dynid/identification/known_friction.hpp"
 #include "dynid/identification/record.hpp"
 #include "dynid/model/model.hpp"
@@ -26,6 +29,13 @@ struct FrictionExperimentOptions {
   double zero_velocity_noise_multiple = 3.0;
   /// Points of the fitted friction curve written for plotting, from −max|dq_J| to +max|dq_J|.
   int curve_points = 101;
+  /// The gravity torque of joint J identified by a gravity or decoupled experiment (seed 2 §3.2):
+  /// replaces the model's g(q)_J in the compensation. Unset: the model's gravity.
+  std::optional<JointGravityModel> gravity;
+  /// The equivalent inertia M_J of a decoupled result [kg·m² or kg]: replaces
+  /// [M(q)q̈ + c(q, q̇)]_J by M_J·q̈_J (exact for joint J moving alone, seed 2 eqs. 21–22). NaN:
+  /// the model's.
+  double equivalent_inertia = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Asymmetric viscous and Coulomb friction of one joint (seed 2 §3.2.2, eq. 2, Table 2).

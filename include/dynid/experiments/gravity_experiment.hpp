@@ -1,5 +1,6 @@
 #pragma once
 
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -114,5 +115,31 @@ GravityPosesResult fit_gravity_poses(const Model& model, const std::vector<Proce
 /// for a joint outside a run.
 int count_distinct_poses(const std::vector<ProcessedRecord>& runs, int joint,
                          const GravityExperimentOptions& options = {});
+
+/// The gravity torque of one joint that a gravity or decoupled experiment identified, τ_g,J(q), to
+/// compensate it in a friction experiment as Bona & Curatella do (seed 2 §3.2: the friction runs
+/// are compensated with the gravity identified from the slopes). Immutable after construction.
+class JointGravityModel {
+ public:
+  /// τ_g,J = k·sin(q_J + q_off) (seed 2 eq. 23): fit_gravity_experiment(), fit_decoupled_joint().
+  /// [N·m or N], [rad].
+  static JointGravityModel sinusoid(int joint, double k, double q_off);
+  /// τ_g,J = Y_g,J(q)·θ_g (fit_gravity_poses()): `names`/`values` its base parameters. Throws
+  /// dynid::Error when the names are not the gravity base parameters of `joint` of `model` (a
+  /// result of another robot or joint).
+  static JointGravityModel poses(const Model& model, int joint,
+                                 const std::vector<std::string>& names,
+                                 const Eigen::VectorXd& values);
+  int joint() const { return joint_; }  ///< 0-based joint index J
+  /// τ_g,J at the positions q (n values) [N·m or N].
+  double torque(const Eigen::VectorXd& q) const;
+
+ private:
+  int joint_ = 0;
+  double k_ = 0.0, q_off_ = 0.0;
+  std::shared_ptr<const Model> model_;  // set for the poses form only
+  Eigen::MatrixXd select_;              // link columns × base parameters of the gravity row
+  Eigen::VectorXd theta_;
+};
 
 }  // namespace dynid

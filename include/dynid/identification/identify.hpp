@@ -111,6 +111,10 @@ struct IdentificationResult {
   Eigen::MatrixXd history_x, history_std;
   /// With a closed-loop preparation: per run, what it chose and found.
   std::vector<ClosedLoopReport> closed_loop;
+  /// With a closed-loop preparation, where the intervals' noise comes from: "projected_residual"
+  /// (the projected equations' own residual) or "torque_remainder" (no degrees of freedom left
+  /// there: the torque outside the projected span, projected_statistics()); empty otherwise.
+  std::string interval_source;
 };
 
 /// What a result's estimates stand for, given a value of every base parameter (base_values, in

@@ -15,6 +15,15 @@
 
 namespace dynid {
 
+/// Values to predict with where a result leaves base parameters undetermined (issue 25 item 2):
+/// the completed base vector of the result (complete_identified_model() with only its not excited
+/// parameters filled from the nominal model, report/stored_result.hpp:
+/// nominal_completion_of_result()). Empty: no nominal value exists.
+struct ParameterCompletion {
+  std::vector<std::string> names;  ///< base parameter names (as identify() names them)
+  Eigen::VectorXd values;          ///< their completed values, same order
+};
+
 /// Per-joint prediction error of identified base parameters on another record (dynid validate).
 /// Two figures: over every row (the headline), and over the rows identify() fits (near-still rows
 /// of a Coulomb model left out: their sign(dq) is noise).
@@ -34,6 +43,13 @@ struct ValidationResult {
   std::vector<std::pair<std::string, std::string>> choices;  ///< processing choices made
   ProcessedRecord processed;
   Eigen::MatrixXd predicted;  ///< samples × n predicted torques
+  /// Parameters the result does not determine but this record excites, predicted at their
+  /// nominal values (ParameterCompletion); empty when the result's own estimates sufficed.
+  std::vector<std::string> completed;
+  /// ‖τ̂ − τ̂_estimates‖/‖τ̂‖ over every row: the share of the predicted torque that the filled
+  /// values carry, (W_u − W_k·D)·θ_u⁰ against W·θ (0 when nothing was filled).
+  double filled_share = 0.0;
+  std::vector<std::string> warnings;  ///< one line per fact the user must know
 };
 
 /// Predicts the torques of `record` with base parameters `values` named `names` (as identify()
@@ -48,11 +64,15 @@ struct ValidationResult {
 /// (IdentificationResult::not_excited): the estimates then hold data regroupings that predict only
 /// motions which leave those directions unexcited too. When this record excites a direction the
 /// result does not determine (the data rank of its determined and undetermined columns together
-/// exceeds that of the determined ones), the prediction would be a wrong number: Error naming the
-/// parameters.
+/// exceeds that of the determined ones), the estimates alone would predict a wrong number: the
+/// record is then predicted with `nominal` (the estimates moved by −D·θ_u⁰ and θ_u = θ_u⁰, which
+/// predicts the identification data exactly as the estimates do), `completed` and
+/// `filled_share` say what was filled and how much of the prediction it carries, with a warning.
+/// Error naming the parameters only when `nominal` is empty (no nominal value exists).
 ValidationResult validate_torques(const Model& model, const JointRecord& record,
                                   const std::vector<std::string>& names,
                                   const Eigen::VectorXd& values, const IdentifyOptions& options,
-                                  const std::vector<std::string>& not_excited = {});
+                                  const std::vector<std::string>& not_excited = {},
+                                  const ParameterCompletion& nominal = {});
 
 }  // namespace dynid

@@ -37,6 +37,10 @@ struct PhysicalFitOptions {
   /// distance by 0.01 σ (docs/performance.md).
   double stall_tolerance = 1e-5;
   int stall_window = 25;  ///< iterations over which stall_tolerance is measured
+  /// Refuse (Error) a nearest consistent set farther than the χ² limit. Off by default: real data
+  /// always carry some model mismatch, so the nearest set is returned with
+  /// PhysicalFit::within_limit false, for the caller to warn (issue 25 item 6).
+  bool refuse_beyond_limit = false;
 };
 
 /// A physically consistent standard parameter set fitted to identified base parameters.
@@ -46,7 +50,8 @@ struct PhysicalFit {
   Eigen::VectorXd theta_b;         ///< their base combination θ_1 + K_d·θ_2
   /// √((θ_b − θ̂_b)ᵀ C⁻¹ (θ_b − θ̂_b)): how far the consistent set is from the estimate [σ].
   double mahalanobis = 0.0;
-  double chi2_limit = 0.0;        ///< √ of the χ²(rank) quantile at confidence_level
+  double chi2_limit = 0.0;  ///< √ of the χ²(estimated parameters) quantile at confidence_level
+  bool within_limit = false;  ///< mahalanobis ≤ chi2_limit: the data accept the consistent set
   double nominal_distance = 0.0;  ///< ‖θ − θ_nominal‖/‖θ_nominal‖ over the link parameters
   /// Per link, the smallest eigenvalue of the pseudo-inertia J (> 0: physically consistent)
   /// [kg·m²].
@@ -69,26 +74,35 @@ struct PhysicalFit {
 /// match, a covariance that is not positive definite, a nominal model without mass on any moving
 /// link (nothing to stay close to), and when no consistent set lies within the χ² limit (the
 /// message says how far, in σ).
+/// `observed` (k × rank, or empty for the identity): what the estimate measures of the base
+/// vector, θ̂ ≈ observed·θ_b(θ) with `covariance` k × k. A result whose data leave base
+/// parameters not excited estimates the kept ones plus their data regrouping, observed =
+/// [selection of the kept] + D·[selection of the not excited]; the not excited directions then
+/// follow the pull towards the nominal model. PhysicalFit::theta_b is the whole base vector.
 PhysicalFit physical_parameters(const Model& nominal, const BaseParameters& base,
                                 const ParameterLayout& layout, const Eigen::VectorXd& theta_b,
                                 const Eigen::MatrixXd& covariance,
-                                const PhysicalFitOptions& options = {});
+                                const PhysicalFitOptions& options = {},
+                                const Eigen::MatrixXd& observed = Eigen::MatrixXd());
 
 /// physical_parameters() of an identification's estimate, with the relative torque error
 /// ‖τ − τ̂‖/‖τ‖ over every row of `run` of the consistent set and of the free estimate.
 struct PhysicalCheck {
-  PhysicalFit fit;              ///< the consistent set
-  double physical_error = 0.0;  ///< torque error of fit.theta_b on the run
-  double free_error = 0.0;      ///< torque error of the identified estimate on the run
+  PhysicalFit fit;                    ///< the consistent set
+  double physical_error = 0.0;        ///< torque error of fit.theta_b on the run
+  double free_error = 0.0;            ///< torque error of the identified estimate on the run
+  std::vector<std::string> warnings;  ///< one line per fact the user must know
 };
 
 /// The consistent set of `result` (identify() of `model` with `options`) and both torque errors
 /// on `run` (validate_torques() with identify's cut-off, result.processed.cutoff_hz), as
 /// `identify --physical` and the Python physical=True report them. `free_error`: the free
 /// estimate's error when the caller already validated it on `run` (else computed). `option`
-/// names the request in the error ("--physical", "physical=True"). Throws dynid::Error when some
-/// base parameter is not excited by the data (the message names the first, and the fix), and as
-/// physical_parameters() and validate_torques().
+/// names the request in messages ("--physical", "physical=True"). Base parameters the data did
+/// not excite are fitted through their data regroupings (physical_parameters()' `observed`) and
+/// take the consistent set's values nearest the nominal model. `warnings` says when the nearest
+/// consistent set lies beyond the χ² limit. Throws as physical_parameters() (a fit that fails)
+/// and validate_torques().
 PhysicalCheck physical_parameters_of_result(const Model& model, const IdentificationResult& result,
                                             const IdentifyOptions& options, const JointRecord& run,
                                             const std::string& option,

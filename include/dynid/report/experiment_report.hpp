@@ -37,10 +37,12 @@ nlohmann::json decoupled_model_to_json(const Model& model, const DecoupledJointR
                                        const nlohmann::json& options_used);
 
 /// Adds the physically consistent fit to an identify result JSON: `standard_parameters` (name,
-/// value), `physically_consistent` and `physical` (mahalanobis, chi2_limit, nominal_distance,
-/// converged, relative_error of the consistent set and relative_error_unconstrained).
+/// value), `physically_consistent` and `physical` (mahalanobis = distance_sigma, chi2_limit,
+/// within_limit, nominal_distance, converged, relative_error of the consistent set and
+/// relative_error_unconstrained, warnings); the warnings are also appended to `warnings`.
 void physical_parameters_to_json(const PhysicalFit& fit, double relative_error,
-                                 double relative_error_unconstrained, nlohmann::json& result);
+                                 double relative_error_unconstrained, nlohmann::json& result,
+                                 const std::vector<std::string>& warnings = {});
 
 /// Two lines for the terminal: how far the consistent set is and what it costs in torque error.
 std::string physical_parameters_text(const PhysicalFit& fit, double relative_error,

@@ -45,6 +45,10 @@ struct IdentifiedResultFile {
   /// are empty in files written before they were stored.
   Eigen::VectorXd std_devs;
   Eigen::MatrixXd covariance, data_regrouping;
+  /// `experiment` of a dedicated-experiment result (gravity, friction, decoupled) and its 1-based
+  /// `joint`; empty and 0 for identify's base-parameter results.
+  std::string experiment;
+  int experiment_joint = 0;
 };
 
 /// Reads a result JSON (identification_to_json). Throws dynid::Error naming the file when

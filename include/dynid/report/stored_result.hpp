@@ -14,9 +14,11 @@
 #include <nlohmann/json.hpp>
 
 #include "dynid/common/error.hpp"
+#include "dynid/experiments/friction_experiment.hpp"
 #include "dynid/identification/identify.hpp"
 #include "dynid/identification/option_text.hpp"
 #include "dynid/identification/record.hpp"
+#include "dynid/identification/validation.hpp"
 #include "dynid/model/model.hpp"
 #include "dynid/physical/completed_model.hpp"
 #include "dynid/regressor/parameter_layout.hpp"
@@ -91,7 +93,28 @@ void add_stored_known_friction(const IdentifiedResultFile& identified, const std
 /// badly determined at the nominal model's values, said in CompletedModel::warnings. Throws
 /// dynid::Error naming `path` (an invalid option, a name that is no base parameter).
 CompletedModel completed_model_of_result(const Model& model, const IdentifiedResultFile& identified,
-                                         const std::string& path);
+                                         const std::string& path,
+                                         const ModelCompletionOptions& completion = {});
+
+/// What validate_torques() predicts with where a stored result leaves base parameters undetermined
+/// and a run excites them (issue 25 item 2): the result completed with only its not excited
+/// parameters at the nominal model's values (completed_model_of_result() with max_relative_std 0:
+/// the badly determined but estimated ones keep their estimates, so a run like the identification
+/// run is predicted exactly as before). Throws as completed_model_of_result().
+ParameterCompletion nominal_completion_of_result(const Model& model,
+                                                 const IdentifiedResultFile& identified,
+                                                 const std::string& path);
+
+/// The compensation a friction experiment of `joint` (0-based) takes from a stored result `path`
+/// (Bona & Curatella's chain, seed 2 §3.2: the friction runs compensated with the gravity the
+/// slopes identified): for a `--model gravity` result its gravity of the joint (k·sin(q_J + q_off)
+/// or the base parameters over all q), for a `--model decoupled` result its gravity and
+/// equivalent inertia; nothing for a base-parameter result (identify's, used through
+/// completed_model_of_result()). Throws dynid::Error naming `path` for a result of another joint
+/// or of a friction experiment.
+void add_stored_friction_compensation(const Model& model, const IdentifiedResultFile& identified,
+                                      const std::string& path, int joint,
+                                      FrictionExperimentOptions& options);
 
 /// `parameter_sources` of a JSON output: identified, nominal_not_excited,
 /// nominal_badly_determined, max_shift_sigma (CompletedModel).
