@@ -35,7 +35,7 @@ void fill_parameter_statistics(Estimate& e, const EstimationOptions& options) {
     // Named as the user gives it (--confidence, confidence_level=), not by the C++ field.
     std::ostringstream shown;
     shown << level;
-    throw Error("the confidence level " + shown.str() +
+    throw Error("the confidence level (confidence_level) " + shown.str() +
                 " is outside (0, 1); give a level such as 0.95 or 0.999 (--confidence)");
   }
   const Eigen::Index p = e.x.size();

@@ -43,7 +43,7 @@ void check_corrupt_samples(const JointRecord& r, const std::string& fix) {
                 std::to_string(c->sample + 1) + " (t = " + short_number(r.t[c->sample]) +
                 " s) = " + short_number(c->value) + " is a corrupt sample: it lies more than " +
                 short_number(c->limit) + " from the median " + short_number(c->median) +
-                " of its column, and the estimate would not be finite; " + fix);
+                " of its column and would make the estimate not finite; " + fix);
   }
 }
 

@@ -122,8 +122,8 @@ void check_plausible_row(const StreamSetup& s, const CsvBlockReader& reader, Wor
                   std::to_string(reader.position(w.block.error_offset).row) + ": " + what.first +
                   std::to_string(j + 1) + " = " + short_number(v) + " is beyond " +
                   short_number(what.second) +
-                  " in magnitude, a corrupt sample (SI units assumed), and the estimate would "
-                  "not be finite; remove or repair that row of the log");
+                  " in magnitude, a corrupt sample (SI units assumed) that would make the "
+                  "estimate not finite; remove or repair that row of the log");
     }
   }
 }
