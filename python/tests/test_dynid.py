@@ -143,6 +143,25 @@ def test_malformed_results_and_non_finite_arrays_raise_dynid_error(planar2):
         dynid.identify(planar2, t, q, corrupt, dq=dq, ddq=ddq, **options)
 
 
+def test_recursive_payload_reports_its_residual_and_what_planar_motion_leaves_undetermined(
+        planar2):
+    """Issue 27 item 3: estimator='rls' reported relative error 0 and the inertias planar motion
+    cannot excite (about z only: Ixx, Iyy, Ixy) as 0 +- 0. Oracle: the physics of a planar arm
+    and the wrench noise of 0.05 added here."""
+    t, q, dq, ddq = fourier_run(8, samples=2000)
+    m, c = 0.8, np.array([0.05, -0.02, 0.03])
+    rng = np.random.default_rng(9)
+    wrench = sensor_wrench(q, dq, ddq, m, c, np.diag([2e-3, 3e-3, 4e-3]))
+    wrench += rng.normal(0.0, 0.05, size=(len(t), 6))
+    result = dynid.payload(planar2, "forearm", t, q, wrench, dq=dq, ddq=ddq, filter=False,
+                           estimator="rls")
+    assert 0.0 < result["relative_error"] < 0.05
+    assert {"Ixx", "Iyy", "Ixy"} <= set(result["not_excited"])
+    values = {p["name"]: p for p in result["parameters"]}
+    for name in ("Ixx", "Iyy", "Ixy"):
+        assert values[name]["value"] is None and values[name]["std"] is None, values[name]
+
+
 def sensor_wrench(q, dq, ddq, m, c, inertia_c):
     """Force and moment a rigid load exerts on a sensor in the forearm frame of planar2, by
     Newton-Euler of the load itself (not dynid's load regressor): f = m (g - a_c),
