@@ -137,6 +137,9 @@ def test_malformed_results_and_non_finite_arrays_raise_dynid_error(planar2):
     t_nan[10] = np.nan
     with pytest.raises(dynid.Error, match="t contains NaN"):
         dynid.identify(planar2, t_nan, q, tau, dq=dq, ddq=ddq, **options)
+    # A NaN cut-off silently became the automatic one.
+    with pytest.raises(dynid.Error, match="cutoff_hz"):
+        dynid.identify(planar2, t, q, tau, dq=dq, ddq=ddq, cutoff_hz=float("nan"))
     corrupt = tau.copy()
     corrupt[523, 1] = 1e200
     with pytest.raises(dynid.Error, match="tau2 at sample 524"):

@@ -30,6 +30,23 @@ std::string fmt(double x) {
 
 }  // namespace
 
+void check_signal_options(const SignalOptions& options) {
+  // A NaN cut-off failed every "> 0" test and silently became the automatic one; a negative
+  // decimation or trim the automatic ones too (the CLI refuses both as flags).
+  if (!(options.cutoff_hz >= 0.0) || !std::isfinite(options.cutoff_hz)) {
+    throw UsageError("the cut-off (--cutoff, cutoff_hz) " + fmt(options.cutoff_hz) +
+                     " is not a finite frequency >= 0 Hz; give e.g. 10, or 0 for automatic");
+  }
+  if (options.decimate < 0) {
+    throw UsageError("the decimation (--decimate, decimate) " + std::to_string(options.decimate) +
+                     " is negative; give 1 or more, or 0 for automatic");
+  }
+  if (options.trim < -1) {
+    throw UsageError("the trim (--trim) " + std::to_string(options.trim) +
+                     " is below -1; give the samples to drop at each end, or -1 for automatic");
+  }
+}
+
 void check_corrupt_samples(const JointRecord& r, const std::string& fix) {
   // Floors of the spread [rad, rad/s, rad/s², N·m]: a column held constant in most samples still
   // moves by up to 1e4 of them (1e5 rad/s² in a ddq column) before a sample counts as corrupt.
@@ -110,6 +127,7 @@ Eigen::MatrixXd stacked_regressor(const Model& model, const ParameterLayout& lay
 ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& options,
                            std::vector<std::pair<std::string, std::string>>& choices) {
   const int n = static_cast<int>(input.q.cols());
+  check_signal_options(options);
   check_record(input, n);
   if (input.t.size() < 10) {
     throw Error("the run has " + std::to_string(input.t.size()) +
