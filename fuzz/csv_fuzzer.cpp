@@ -2,15 +2,23 @@
 // (CsvChunkReader, with a tiny buffer so that line and buffer boundaries are exercised) and the run
 // reader on top (read_joint_record for the built-in planar2), and the block reader of
 // identify_stream (CsvBlockReader, blocks of a few bytes). All implement one format
-// (csv_reader.hpp), so they must accept the same inputs and return the same numbers.
+// (csv_reader.hpp), so they must accept the same inputs and return the same numbers. An accepted
+// run then goes through a one-joint experiment and an abandoned batch of outputs.
 
 #include <cstdint>
+#include <fstream>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
+#include "dynid/experiments/decoupled_model.hpp"
+#include "dynid/identification/record.hpp"
+#include "dynid/io/atomic_file.hpp"
 #include "dynid/io/csv_chunk_reader.hpp"
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/io/joint_record_file.hpp"
+#include "dynid/io/json_writer.hpp"
 #include "dynid/model/robots.hpp"
 #include "fuzz_support.hpp"
 
@@ -94,6 +102,22 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const JointRecord record = read_joint_record(path, planar2);
     fuzz::require(record.t.allFinite() && record.q.allFinite() && record.tau.allFinite(),
                   "read_joint_record returns finite samples");
+    // The one-joint experiment path (identify --model decoupled, issue 27 item 6): a run that
+    // preprocess() accepts gives a finite fit or a dynid::Error, never NaN.
+    SignalOptions signal;
+    signal.filter = false;
+    std::vector<std::pair<std::string, std::string>> choices;
+    const std::vector<ProcessedRecord> runs = {preprocess(record, signal, choices)};
+    const DecoupledJointResult fit = fit_decoupled_joint(runs, 0);
+    fuzz::require(fit.estimate.x.allFinite(), "an accepted one-joint experiment is finite");
+    // The temporary-file path: outputs of a batch that is never committed leave nothing.
+    const std::string out = path + ".result.json";
+    {
+      OutputBatch batch;
+      write_json(out, nlohmann::json{{"relative_error", json_number(fit.relative_error)}});
+    }
+    fuzz::require(temporary_files_in_flight() == 0, "an abandoned batch removes its files");
+    fuzz::require(!std::ifstream(out), "an abandoned batch renames nothing");
   });
   return 0;
 }

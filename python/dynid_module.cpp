@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/dynamics/rnea.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
 #include "dynid/identification/identify.hpp"
@@ -378,8 +379,18 @@ IdentifyOptions options_of_result(const Model& model, const IdentifiedResultFile
 // command line.
 IdentifiedResultFile identified_result(const Model& model, const py::dict& result,
                                        const std::string& what) {
-  const nlohmann::json j =
-      nlohmann::json::parse(py::module_::import("json").attr("dumps")(result).cast<std::string>());
+  // allow_nan=False: a NaN or Inf value is refused here by name, as the command line refuses it,
+  // instead of reaching the JSON parser as the non-JSON token NaN.
+  std::string text;
+  try {
+    text = py::module_::import("json")
+               .attr("dumps")(result, py::arg("allow_nan") = false)
+               .cast<std::string>();
+  } catch (const py::error_already_set& e) {
+    throw Error("the " + what + " holds a value a result cannot have (" + one_line(e.what()) +
+                "); give finite numbers, as dynid.identify returns them");
+  }
+  const nlohmann::json j = nlohmann::json::parse(text);
   IdentifiedResultFile identified = identification_result_from_json(j, what);
   if (!identified.robot.empty() && identified.robot != model.name) {
     throw Error("the " + what + " is of robot '" + identified.robot + "', not '" + model.name +
@@ -509,7 +520,23 @@ PYBIND11_MODULE(dynid, m) {
       "Arrays "
       "of samples are (samples x joints) float64.";
   m.attr("__version__") = kVersion;
-  py::register_exception<Error>(m, "Error", PyExc_ValueError);
+  static PyObject* error_type = py::register_exception<Error>(m, "Error", PyExc_ValueError).ptr();
+  // What escapes the library as another type is still a dynid.Error with a plain message: a
+  // malformed result dict's JSON type error, a value pybind11 cannot convert.
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const nlohmann::json::exception& e) {
+      std::string text = e.what();
+      const auto tag = text.find("] ");
+      if (!text.empty() && text[0] == '[' && tag != std::string::npos) text.erase(0, tag + 2);
+      PyErr_SetString(error_type, ("a result value has the wrong type: " + text).c_str());
+    } catch (const py::cast_error& e) {
+      PyErr_SetString(error_type, (std::string("an argument has the wrong type: ") + e.what() +
+                                   "; pass numbers and float64 arrays")
+                                      .c_str());
+    }
+  });
 
   py::class_<Model>(m, "Model", "An immutable robot model (kinematic tree, inertias, friction).")
       .def_readonly("name", &Model::name, "Robot name")

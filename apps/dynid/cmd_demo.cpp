@@ -8,6 +8,7 @@
 
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
+#include "dynid/io/atomic_file.hpp"
 #include "dynid/report/html_report.hpp"
 #include "dynid/workflow/demo.hpp"
 
@@ -43,22 +44,31 @@ void run(const DemoCliOptions& c) {
     throw Error("--report '" + c.report + "': folder '" + folder.string() +
                 "' does not exist; create it or write elsewhere");
   }
+  // Nothing of a failed demo stays behind: every file waits in the batch until the report is
+  // written too, and a folder the demo created is removed again.
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const bool folder_existed = fs::exists(o.out_dir, ec);
   const auto start = std::chrono::steady_clock::now();
-  const DemoResult r = run_demo(o, [&](const std::string& line) {
-    const double s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (!c.quiet) std::cerr << "[" << static_cast<int>(s) << " s] " << line << std::endl;
-  });
-  // The report of the files the demo wrote, as `dynid report --in` would make it.
-  const std::filesystem::path dir(o.out_dir);
-  std::vector<ReportInput> inputs;
-  for (const char* name : {"excitation.json", "result.json", "validation.json"}) {
-    inputs.push_back(read_report_input((dir / name).string()));
+  DemoResult r;
+  std::string report;
+  try {
+    OutputBatch outputs;
+    r = run_demo(o, [&](const std::string& line) {
+      const double s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (!c.quiet) std::cerr << "[" << static_cast<int>(s) << " s] " << line << std::endl;
+    });
+    // The report of the files the demo wrote, as `dynid report --in` would make it.
+    report = c.report.empty() ? (fs::path(o.out_dir) / "report.html").string() : c.report;
+    HtmlReportOptions options;
+    options.title = "dynid demo: " + o.robot;
+    write_html_report(report, r.reports, options);
+    outputs.commit();
+  } catch (...) {
+    if (!folder_existed) fs::remove(o.out_dir, ec);  // only when empty: never a user's file
+    throw;
   }
-  const std::string report = c.report.empty() ? (dir / "report.html").string() : c.report;
-  HtmlReportOptions options;
-  options.title = "dynid demo: " + o.robot;
-  write_html_report(report, inputs, options);
   std::cout << r.table << "files written to " << o.out_dir << "; report " << report << '\n';
 }
 

@@ -16,7 +16,9 @@
 #include "dynid/excitation/joint_fourier.hpp"
 #include "dynid/excitation/polynomial_spline.hpp"
 #include "dynid/excitation/slope_trajectory.hpp"
+#include "dynid/excitation/trajectory_samples.hpp"
 #include "dynid/excitation/trapezoidal_trajectory.hpp"
+#include "dynid/io/atomic_file.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/report/excitation_report.hpp"
@@ -269,6 +271,14 @@ void run_excite(const ExciteCliOptions& o) {
   }
   if (o.harmonics < 1) throw UsageError("--harmonics must be >= 1");
   if (!(o.f0 > 0.0)) throw UsageError("--f0 must be > 0 Hz");
+  if (o.rate > 0.0) {  // before the optimisation: its trajectory is one period at --rate
+    try {
+      check_trajectory_samples(1.0 / o.f0, o.rate,
+                               "--f0 " + short_number(o.f0) + " Hz gives a period of");
+    } catch (const Error& e) {
+      throw UsageError(std::string(e.what()) + " (--f0, --rate)");
+    }
+  }
   if (o.joint != 0) {  // one joint, Schroeder phases scaled to --range (joint_fourier_reference)
     if (!o.json.empty())
       throw UsageError(
@@ -322,9 +332,11 @@ void run_excite(const ExciteCliOptions& o) {
               << " (written anyway: --allow-violations)\n";
   }
   std::cout << excitation_text(result);
+  OutputBatch outputs;  // both files or neither
   if (!o.json.empty()) write_json(o.json, excitation_to_json(result));
   write_trajectory_csv(o.out,
                        sample_trajectory(FourierTrajectory(result.coefficients), o.rate, true));
+  outputs.commit();
   std::cout << "wrote " << o.out << (o.json.empty() ? "" : " and " + o.json) << '\n';
 }
 

@@ -12,6 +12,7 @@
 
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
+#include "dynid/common/input_file.hpp"
 #include "dynid/common/message.hpp"
 #include "dynid/common/progress.hpp"
 #include "dynid/experiments/decoupled_model.hpp"
@@ -83,6 +84,7 @@ void require_readable(const std::string& path, const char* flag) {
   if (fs::is_directory(path, ec)) {
     throw Error(std::string(flag) + " '" + path + "' is a folder; give the file");
   }
+  require_regular_file(path, flag);  // opening a FIFO to test it would wait for a writer
   if (!std::ifstream(path)) {
     throw Error(std::string(flag) + " '" + path +
                 "' cannot be opened (missing or unreadable); check the path");
@@ -676,7 +678,7 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
     const std::string beside = gains_file_for_run(v.data);
     if (!v.gains.empty()) {
       gains = read_pid_gains(v.gains, model);
-    } else if (std::ifstream(beside)) {
+    } else if (std::error_code ec; std::filesystem::exists(beside, ec)) {  // a FIFO is refused
       gains = read_pid_gains(beside, model);
       read.notes.push_back("controller gains from '" + beside + "'");
     }

@@ -17,6 +17,7 @@
 #include "dynid/common/message.hpp"
 #include "dynid/identification/identify.hpp"
 #include "dynid/identification/validation.hpp"
+#include "dynid/io/atomic_file.hpp"
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/io/csv_writer.hpp"
 #include "dynid/io/joint_columns.hpp"
@@ -75,6 +76,7 @@ void write_result(const PayloadCliOptions& cli, const LoadIdentificationResult& 
     std::cerr << "warning: the identified load is not physically consistent: "
               << one_line(r.physics.violated) << '\n';
   }
+  OutputBatch outputs;  // the result, its history and its report, or none of them
   write_json(cli.out, out);
   if (!cli.history.empty()) {
     std::vector<std::string> columns = {"row"};
@@ -85,15 +87,14 @@ void write_result(const PayloadCliOptions& cli, const LoadIdentificationResult& 
     history.rightCols(r.history.cols()) = r.history;
     write_csv(cli.history, columns, history);
   }
+  if (!cli.report.empty()) write_html_report(cli.report, {{cli.out, out}}, {});
+  outputs.commit();
   std::cout << "payload: m "
             << (mass_known ? "= " + std::to_string(e.x(0)) + " kg" : "not determined");
   if (r.physics.mass > 0.0) std::cout << ", c = " << r.physics.com.transpose() << " m";
   std::cout << (r.physics.consistent ? ", physically consistent" : ", NOT physically consistent")
             << "; wrote " << cli.out << '\n';
-  if (!cli.report.empty()) {
-    write_html_report(cli.report, {{cli.out, out}}, {});
-    std::cout << "wrote " << cli.report << '\n';
-  }
+  if (!cli.report.empty()) std::cout << "wrote " << cli.report << '\n';
 }
 
 // The JSON of a load from joint torques: where it is expressed and which parameters the torques

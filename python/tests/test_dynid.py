@@ -118,6 +118,53 @@ def test_bad_input_raises_with_a_message(planar2):
         dynid.inverse_dynamics(planar2, nan, nan, nan)
 
 
+def test_malformed_results_and_non_finite_arrays_raise_dynid_error(planar2):
+    """Issue 27 item 5: a result dict with NaN, or a value of the wrong type, raised a raw
+    [json.exception...] error; a NaN time stamp or one corrupt sample reached the fit."""
+    t, q, dq, ddq = fourier_run(4)
+    tau = planar2_torques(q, dq, ddq)
+    options = dict(armature=False, viscous=False, coulomb=False, offset=False, filter=False)
+    result = dynid.identify(planar2, t, q, tau, dq=dq, ddq=ddq, **options)
+    bad = dict(result, parameters=[dict(p, value=float("nan")) for p in result["parameters"]])
+    with pytest.raises(dynid.Error, match="finite numbers") as e:
+        dynid.validate(planar2, bad, t, q, tau, dq=dq, ddq=ddq)
+    assert "json.exception" not in str(e.value)
+    typed = dict(result, parameters=[dict(p, value="one") for p in result["parameters"]])
+    with pytest.raises(dynid.Error) as e:
+        dynid.validate(planar2, typed, t, q, tau, dq=dq, ddq=ddq)
+    assert "json.exception" not in str(e.value)
+    t_nan = t.copy()
+    t_nan[10] = np.nan
+    with pytest.raises(dynid.Error, match="t contains NaN"):
+        dynid.identify(planar2, t_nan, q, tau, dq=dq, ddq=ddq, **options)
+    # A NaN cut-off silently became the automatic one.
+    with pytest.raises(dynid.Error, match="cutoff_hz"):
+        dynid.identify(planar2, t, q, tau, dq=dq, ddq=ddq, cutoff_hz=float("nan"))
+    corrupt = tau.copy()
+    corrupt[523, 1] = 1e200
+    with pytest.raises(dynid.Error, match="tau2 at sample 524"):
+        dynid.identify(planar2, t, q, corrupt, dq=dq, ddq=ddq, **options)
+
+
+def test_recursive_payload_reports_its_residual_and_what_planar_motion_leaves_undetermined(
+        planar2):
+    """Issue 27 item 3: estimator='rls' reported relative error 0 and the inertias planar motion
+    cannot excite (about z only: Ixx, Iyy, Ixy) as 0 +- 0. Oracle: the physics of a planar arm
+    and the wrench noise of 0.05 added here."""
+    t, q, dq, ddq = fourier_run(8, samples=2000)
+    m, c = 0.8, np.array([0.05, -0.02, 0.03])
+    rng = np.random.default_rng(9)
+    wrench = sensor_wrench(q, dq, ddq, m, c, np.diag([2e-3, 3e-3, 4e-3]))
+    wrench += rng.normal(0.0, 0.05, size=(len(t), 6))
+    result = dynid.payload(planar2, "forearm", t, q, wrench, dq=dq, ddq=ddq, filter=False,
+                           estimator="rls")
+    assert 0.0 < result["relative_error"] < 0.05
+    assert {"Ixx", "Iyy", "Ixy"} <= set(result["not_excited"])
+    values = {p["name"]: p for p in result["parameters"]}
+    for name in ("Ixx", "Iyy", "Ixy"):
+        assert values[name]["value"] is None and values[name]["std"] is None, values[name]
+
+
 def sensor_wrench(q, dq, ddq, m, c, inertia_c):
     """Force and moment a rigid load exerts on a sensor in the forearm frame of planar2, by
     Newton-Euler of the load itself (not dynid's load regressor): f = m (g - a_c),

@@ -20,16 +20,15 @@ OnlineIdentification::OnlineIdentification(const Model& model, const ParameterLa
       y_full_(model.dof(), layout.columns(model.dof())) {
   const double lambda = options.forgetting_factor;
   if (!(lambda > 0.0 && lambda <= 1.0)) {
-    throw Error("OnlineIdentificationOptions::forgetting_factor is " + std::to_string(lambda) +
+    throw Error("the forgetting factor (forgetting_factor) is " + std::to_string(lambda) +
                 "; pass a value in (0, 1], e.g. 0.999 (1 = no forgetting)");
   }
   if (!(options.initial_covariance > 0.0) || !std::isfinite(options.initial_covariance)) {
-    throw Error("OnlineIdentificationOptions::initial_covariance is " +
+    throw Error("the initial covariance (initial_covariance) is " +
                 std::to_string(options.initial_covariance) + "; pass c > 0 (P0 = c*I, e.g. 1e4)");
   }
   if (!(options.max_covariance >= options.initial_covariance)) {
-    throw Error("OnlineIdentificationOptions::max_covariance is " +
-                std::to_string(options.max_covariance) +
+    throw Error("the max covariance (max_covariance) is " + std::to_string(options.max_covariance) +
                 "; pass a value >= initial_covariance (or +inf to disable the limit)");
   }
   const int columns = layout.columns(model.dof());

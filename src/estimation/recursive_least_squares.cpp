@@ -21,11 +21,11 @@ RecursiveLeastSquares::RecursiveLeastSquares(Eigen::Index parameters,
                 "; the regressor needs at least one column");
   }
   if (!(options.initial_covariance > 0.0) || !std::isfinite(options.initial_covariance)) {
-    throw Error("RecursiveLeastSquaresOptions::initial_covariance is " +
+    throw Error("the initial covariance (initial_covariance) is " +
                 std::to_string(options.initial_covariance) + "; pass c > 0 (P0 = c*I, e.g. 1e8)");
   }
   if (!(options.forgetting_factor > 0.0 && options.forgetting_factor <= 1.0)) {
-    throw Error("RecursiveLeastSquaresOptions::forgetting_factor is " +
+    throw Error("the forgetting factor (forgetting_factor) is " +
                 std::to_string(options.forgetting_factor) +
                 "; pass a value in (0, 1] (1 = no forgetting)");
   }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -31,8 +32,11 @@ double student_t_quantile(double level, double dof) {
 void fill_parameter_statistics(Estimate& e, const EstimationOptions& options) {
   const double level = options.confidence_level;
   if (!(level > 0.0 && level < 1.0)) {
-    throw Error("EstimationOptions::confidence_level " + std::to_string(level) +
-                " is outside (0, 1); pass a level such as 0.95 or 0.999");
+    // Named as the user gives it (--confidence, confidence_level=), not by the C++ field.
+    std::ostringstream shown;
+    shown << level;
+    throw Error("the confidence level (confidence_level) " + shown.str() +
+                " is outside (0, 1); give a level such as 0.95 or 0.999 (--confidence)");
   }
   const Eigen::Index p = e.x.size();
   const double inf = std::numeric_limits<double>::infinity();

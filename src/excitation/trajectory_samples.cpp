@@ -4,8 +4,18 @@
 #include <string>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 
 namespace dynid {
+
+void check_trajectory_samples(double duration, double rate, const std::string& what) {
+  if (!(duration * rate > kMaxTrajectorySamples)) return;
+  throw Error(what + " " + short_number(duration) + " s, " + short_number(duration * rate) +
+              " samples at " + short_number(rate) + " Hz, more than the " +
+              short_number(kMaxTrajectorySamples) +
+              " a trajectory may have; shorten it (a higher fundamental frequency, a shorter "
+              "duration) or lower the rate");
+}
 
 TrajectorySamples sample_trajectory(const Trajectory& trajectory, double rate, bool include_end) {
   if (!std::isfinite(rate) || rate <= 0.0)
@@ -13,6 +23,7 @@ TrajectorySamples sample_trajectory(const Trajectory& trajectory, double rate, b
   const double duration = trajectory.duration();
   if (!(duration > 0.0) || !std::isfinite(duration))
     throw Error("trajectory: duration must be finite and > 0 s to be sampled");
+  check_trajectory_samples(duration, rate, "the trajectory lasts");
   // Guard against t = k/rate landing a rounding error beyond the end.
   const double steps = duration * rate;
   Eigen::Index m = static_cast<Eigen::Index>(std::floor(steps + 1e-9));

@@ -11,6 +11,7 @@
 #include "dynid/model/transmission.hpp"
 #include "dynid/signal/noise_floor.hpp"
 #include "dynid/signal/sampling_check.hpp"
+#include "identification/preparation.hpp"
 
 namespace dynid {
 
@@ -94,6 +95,7 @@ std::string percent(double fraction) {
 CutoffSelection select_cutoff(const Model& model, const JointRecord& record,
                               const IdentifyOptions& options,
                               const CutoffSelectionOptions& selection) {
+  check_signal_options(options.signal);  // a NaN cut-off is no request for the automatic one
   CutoffSelection out;
   out.signal = options.signal;
   if (!options.signal.filter || options.signal.cutoff_hz > 0.0) return out;

@@ -6,6 +6,7 @@
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
 #include "dynid/signal/plausibility.hpp"
+#include "identification/preparation.hpp"
 
 namespace dynid {
 namespace {
@@ -80,6 +81,13 @@ ScreenedRun screen_run(const Model& model, const JointRecord& record,
   }
   s.record = record;
   if (!record.tau.allFinite()) return s;  // identify() names the NaN itself
+  if (options.policy == OutlierPolicy::kReport) {
+    // Kept, a corrupt torque would stop preprocess() later; here the fix can name the flag.
+    JointRecord torques;
+    torques.t = record.t;
+    torques.tau = record.tau;
+    check_corrupt_samples(torques, "pass --outliers drop or clean the log");
+  }
   s.outliers = find_torque_outliers(record.tau, options);
   if (s.outliers.empty()) return s;
   const std::string list = describe(s.outliers, record);

@@ -21,6 +21,16 @@ ProcessedRecord preprocess_run(const Model& model, const JointRecord& record,
                                const SignalOptions& options,
                                std::vector<std::pair<std::string, std::string>>& choices);
 
+/// Throws dynid::UsageError for a cut-off that is NaN, infinite or negative, a negative decimation
+/// or a trim below −1: values the automatic rules would otherwise silently replace.
+void check_signal_options(const SignalOptions& options);
+
+/// Throws dynid::Error for the first sample of r.q, r.dq, r.ddq or r.tau that find_corrupt_sample()
+/// (signal/plausibility.hpp) flags, naming column, sample, time and value, then `fix`. preprocess()
+/// calls it, so every path that prepares a run (differential, integral, gravity, friction,
+/// decoupled, payload, validate) refuses the sample before it turns the estimate into NaN.
+void check_corrupt_samples(const JointRecord& r, const std::string& fix);
+
 /// Per joint, the |dq_j| [rad/s or m/s] below which rows are left out of a Coulomb model's fit:
 /// the given signal.zero_velocity (1 or n values), or max(zero_velocity_fraction × max|dq_j|,
 /// zero_velocity_noise_multiple × the processed velocity's noise std). Zeros without Coulomb

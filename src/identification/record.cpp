@@ -6,11 +6,13 @@
 #include <sstream>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/dynamics/workspace.hpp"
 #include "dynid/model/transmission.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
 #include "dynid/signal/differentiation.hpp"
 #include "dynid/signal/noise_floor.hpp"
+#include "dynid/signal/plausibility.hpp"
 #include "dynid/signal/resampling.hpp"
 #include "dynid/signal/sampling_check.hpp"
 #include "dynid/signal/zero_phase_filter.hpp"
@@ -26,6 +28,44 @@ std::string fmt(double x) {
   return s.str();
 }
 
+}  // namespace
+
+void check_signal_options(const SignalOptions& options) {
+  // A NaN cut-off failed every "> 0" test and silently became the automatic one; a negative
+  // decimation or trim the automatic ones too (the CLI refuses both as flags).
+  if (!(options.cutoff_hz >= 0.0) || !std::isfinite(options.cutoff_hz)) {
+    throw UsageError("the cut-off (--cutoff, cutoff_hz) " + fmt(options.cutoff_hz) +
+                     " is not a finite frequency >= 0 Hz; give e.g. 10, or 0 for automatic");
+  }
+  if (options.decimate < 0) {
+    throw UsageError("the decimation (--decimate, decimate) " + std::to_string(options.decimate) +
+                     " is negative; give 1 or more, or 0 for automatic");
+  }
+  if (options.trim < -1) {
+    throw UsageError("the trim (--trim) " + std::to_string(options.trim) +
+                     " is below -1; give the samples to drop at each end, or -1 for automatic");
+  }
+}
+
+void check_corrupt_samples(const JointRecord& r, const std::string& fix) {
+  // Floors of the spread [rad, rad/s, rad/s², N·m]: a column held constant in most samples still
+  // moves by up to 1e4 of them (1e5 rad/s² in a ddq column) before a sample counts as corrupt.
+  const std::pair<const Eigen::MatrixXd*, std::pair<const char*, double>> columns[] = {
+      {&r.q, {"q", 1.0}}, {&r.dq, {"dq", 1.0}}, {&r.ddq, {"ddq", 10.0}}, {&r.tau, {"tau", 1.0}}};
+  for (const auto& [x, what] : columns) {
+    if (x->size() == 0 || x->rows() != r.t.size()) continue;
+    const std::optional<CorruptSample> c = find_corrupt_sample(*x, what.second);
+    if (!c) continue;
+    throw Error(std::string(what.first) + std::to_string(c->column + 1) + " at sample " +
+                std::to_string(c->sample + 1) + " (t = " + short_number(r.t[c->sample]) +
+                " s) = " + short_number(c->value) + " is a corrupt sample: it lies more than " +
+                short_number(c->limit) + " from the median " + short_number(c->median) +
+                " of its column and would make the estimate not finite; " + fix);
+  }
+}
+
+namespace {
+
 void check_record(const JointRecord& r, int n) {
   const Eigen::Index m = r.t.size();
   auto check = [&](const Eigen::MatrixXd& x, const char* what, bool optional) {
@@ -37,10 +77,12 @@ void check_record(const JointRecord& r, int n) {
     }
     if (!x.allFinite()) throw Error(std::string(what) + " contains NaN or Inf; clean the data");
   };
+  if (!r.t.allFinite()) throw Error("t contains NaN or Inf; clean the data");
   check(r.q, "q", false);
   check(r.dq, "dq", true);
   check(r.ddq, "ddq", true);
   check(r.tau, "tau", false);
+  check_corrupt_samples(r, "remove or repair that row of the log");
 }
 
 Eigen::MatrixXd take_rows(const Eigen::MatrixXd& x, Eigen::Index first, Eigen::Index last,
@@ -85,6 +127,7 @@ Eigen::MatrixXd stacked_regressor(const Model& model, const ParameterLayout& lay
 ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& options,
                            std::vector<std::pair<std::string, std::string>>& choices) {
   const int n = static_cast<int>(input.q.cols());
+  check_signal_options(options);
   check_record(input, n);
   if (input.t.size() < 10) {
     throw Error("the run has " + std::to_string(input.t.size()) +

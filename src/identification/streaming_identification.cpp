@@ -12,9 +12,11 @@
 #include <thread>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/estimation/streaming_least_squares.hpp"
 #include "dynid/io/csv_chunk_reader.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
+#include "dynid/signal/plausibility.hpp"
 
 namespace dynid {
 
@@ -99,6 +101,33 @@ struct StreamSetup {
   Eigen::VectorXd threshold;
 };
 
+// A row no robot run holds (signal/plausibility.hpp's fixed bounds: the stream never sees a whole
+// column, so the median test of preprocess() cannot run) would overflow the accumulated normal
+// equations into an all-NaN fit; refused naming the row.
+void check_plausible_row(const StreamSetup& s, const CsvBlockReader& reader, Worker& w,
+                         Eigen::Index k) {
+  const CsvChunkReader::RowBlock& block = w.block.rows;
+  const int n = s.model->dof();
+  const std::pair<const std::vector<Eigen::Index>*, std::pair<const char*, double>> columns[] = {
+      {&s.cq, {"q", kMaxPlausiblePosition}},
+      {&s.cdq, {"dq", kMaxPlausibleVelocity}},
+      {&s.cddq, {"ddq", kMaxPlausibleAcceleration}},
+      {&s.ctau, {"tau", kMaxPlausibleTorque}}};
+  for (const auto& [index, what] : columns) {
+    for (int j = 0; j < n; ++j) {
+      const double v = block(k, (*index)[static_cast<std::size_t>(j)]);
+      if (std::abs(v) <= what.second) continue;
+      w.block.error_offset = w.block.offsets[static_cast<std::size_t>(k)];
+      throw Error("'" + s.path + "' data row " +
+                  std::to_string(reader.position(w.block.error_offset).row) + ": " + what.first +
+                  std::to_string(j + 1) + " = " + short_number(v) + " is beyond " +
+                  short_number(what.second) +
+                  " in magnitude, a corrupt sample (SI units assumed) that would make the "
+                  "estimate not finite; remove or repair that row of the log");
+    }
+  }
+}
+
 void process_block(const StreamSetup& s, const CsvBlockReader& reader, Worker& w) {
   const Model& model = *s.model;
   const int n = model.dof();
@@ -110,6 +139,7 @@ void process_block(const StreamSetup& s, const CsvBlockReader& reader, Worker& w
       w.dq[j] = block(k, s.cdq[j]);
       w.ddq[j] = block(k, s.cddq[j]);
     }
+    check_plausible_row(s, reader, w, k);
     torque_regressor(model, w.ws, *s.layout, w.q, w.dq, w.ddq, w.Y);
     const double* y = w.Y.data();
     const bool check = k % kStructuralCheckStride == 0;

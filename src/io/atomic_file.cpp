@@ -13,6 +13,7 @@
 #include <cstring>
 #include <mutex>
 #include <streambuf>
+#include <string>
 #include <vector>
 
 #include "dynid/common/error.hpp"
@@ -204,6 +205,61 @@ struct Fd {
 
 }  // namespace
 
+// A file written completely to its temporary name, waiting for OutputBatch::commit().
+struct OutputBatch::Pending {
+  int dirfd = -1;  // owned: closed when the entry is done
+  int slot = -1;
+  std::string tmp, base, path;
+};
+
+namespace {
+
+thread_local std::vector<OutputBatch::Pending>* t_batch = nullptr;
+
+void finish_pending(OutputBatch::Pending& p, bool remove) {
+  if (remove) ::unlinkat(p.dirfd, p.tmp.c_str(), 0);
+  release_slot(p.slot);
+  g_in_flight.fetch_sub(1);
+  ::close(p.dirfd);
+}
+
+}  // namespace
+
+OutputBatch::OutputBatch() : pending_(new std::vector<Pending>) {
+  if (t_batch != nullptr) {
+    delete pending_;
+    throw Error("internal: an output batch is already open on this thread");
+  }
+  t_batch = pending_;
+}
+
+OutputBatch::~OutputBatch() {
+  if (t_batch == pending_) t_batch = nullptr;
+  for (Pending& p : *pending_) finish_pending(p, true);
+  delete pending_;
+}
+
+void OutputBatch::commit() {
+  t_batch = nullptr;
+  std::vector<Pending> pending = std::move(*pending_);
+  pending_->clear();
+  std::size_t done = 0;
+  try {
+    for (; done < pending.size(); ++done) {
+      Pending& p = pending[done];
+      check_target_at(p.dirfd, p.base, p.path, "");
+      if (::renameat(p.dirfd, p.tmp.c_str(), p.dirfd, p.base.c_str()) != 0) {
+        throw Error(p.path + ": cannot rename the temporary file into place (" +
+                    std::strerror(errno) + "); check that the path is not a directory");
+      }
+      finish_pending(p, false);
+    }
+  } catch (...) {
+    for (std::size_t i = done; i < pending.size(); ++i) finish_pending(pending[i], true);
+    throw;
+  }
+}
+
 void check_output_target(const std::string& path, const std::string& flag) {
   if (path.empty()) return;
   check_target_at(AT_FDCWD, path, path, flag);
@@ -273,6 +329,12 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
     }
     if (fd.close() != 0) {
       throw Error(path + ": write failed on close (" + std::strerror(errno) + "); check the disk");
+    }
+    if (t_batch != nullptr) {
+      // Renamed by OutputBatch::commit(), with the other outputs of the command.
+      t_batch->push_back({dirfd.fd, slot, tmp, base, path});
+      dirfd.fd = -1;
+      return;
     }
     // Again just before the rename: a device or FIFO created at the name meanwhile is refused.
     check_target_at(dirfd.fd, base, path, "");

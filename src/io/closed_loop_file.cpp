@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/input_file.hpp"
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/io/joint_columns.hpp"
 #include "dynid/io/json_writer.hpp"
@@ -44,6 +45,7 @@ ReferenceRecord read_reference_columns(const std::string& path, const Model& mod
 
 SensorNoise read_sensor_noise(const std::string& path, const Model& model, const std::string& data,
                               std::string* which) {
+  require_regular_file(path, "--noise");
   std::ifstream in(path);
   if (!in) throw Error("--noise '" + path + "' cannot be opened; check the path");
   nlohmann::json j;

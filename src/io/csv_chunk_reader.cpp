@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/input_file.hpp"
 #include "dynid/io/csv_reader.hpp"
 #include "io/csv_parse.hpp"
 
@@ -103,6 +104,7 @@ CsvChunkReader::CsvChunkReader(const std::string& path, const CsvChunkOptions& o
   impl_->source = path;
   impl_->options = options;
   impl_->buffer.resize(std::max<std::size_t>(options.buffer_bytes, 64));
+  require_regular_file(path, "CSV file");
   impl_->file = std::fopen(path.c_str(), "rb");
   if (impl_->file == nullptr) {
     throw Error(path + ": cannot open (" + std::strerror(errno) +

@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/input_file.hpp"
 #include "io/csv_parse.hpp"
 
 namespace dynid {
@@ -21,6 +22,7 @@ std::string read_whole_file(const std::string& path) {
   if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
     throw Error(path + ": is a directory; give the path of a CSV file to --in");
   }
+  require_regular_file(path, "CSV file");
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
                                                        &std::fclose);
   if (!file) {

@@ -9,6 +9,7 @@
 
 #include "dynid/common/error.hpp"
 #include "dynid/io/atomic_file.hpp"
+#include "dynid/io/markup.hpp"
 
 namespace dynid {
 
@@ -54,16 +55,16 @@ ComInertial com_inertial(const LinkParams& p) {
 
 std::string to_urdf(const Model& model, const UrdfWriteOptions& options) {
   std::ostringstream out;
-  out << "<?xml version=\"1.0\"?>\n<robot name=\"" << (model.name.empty() ? "robot" : model.name)
-      << "\">\n";
+  out << "<?xml version=\"1.0\"?>\n<robot name=\""
+      << markup_escaped(model.name.empty() ? "robot" : model.name) << "\">\n";
   if (options.mujoco_compiler_tag) {
     out << "  <mujoco><compiler discardvisual=\"true\" fusestatic=\"false\" "
            "balanceinertia=\"false\" angle=\"radian\"/></mujoco>\n";
   }
-  out << "  <link name=\"" << options.root_link << "\"/>\n";
+  out << "  <link name=\"" << markup_escaped(options.root_link) << "\"/>\n";
   auto link_name = [&](int j) {
     const Joint& joint = model.joints[j];
-    return joint.link_name.empty() ? joint.name + "_link" : joint.link_name;
+    return markup_escaped(joint.link_name.empty() ? joint.name + "_link" : joint.link_name);
   };
   for (int j = 0; j < model.dof(); ++j) {
     const LinkParams& p = model.links[j];
@@ -87,8 +88,9 @@ std::string to_urdf(const Model& model, const UrdfWriteOptions& options) {
     const bool prismatic = joint.type == JointType::kPrismatic;
     const bool bounded = std::isfinite(joint.limits.lower) && std::isfinite(joint.limits.upper);
     const char* type = prismatic ? "prismatic" : (bounded ? "revolute" : "continuous");
-    out << "  <joint name=\"" << joint.name << "\" type=\"" << type << "\">\n"
-        << "    <parent link=\"" << (joint.parent < 0 ? options.root_link : link_name(joint.parent))
+    out << "  <joint name=\"" << markup_escaped(joint.name) << "\" type=\"" << type << "\">\n"
+        << "    <parent link=\""
+        << (joint.parent < 0 ? markup_escaped(options.root_link) : link_name(joint.parent))
         << "\"/>\n    <child link=\"" << link_name(j) << "\"/>\n"
         << "    <origin xyz=\"" << vec3(joint.p_PJ) << "\" rpy=\""
         << vec3(rpy_from_rotation(joint.R_PJ)) << "\"/>\n    <axis xyz=\"" << vec3(joint.axis)

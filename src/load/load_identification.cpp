@@ -373,6 +373,36 @@ LoadPhysics load_physics(const Eigen::Ref<const Eigen::VectorXd>& phi, bool with
 
 namespace {
 
+// The U-D recursion (seed 1 §IV) starts from a prior P0 = c·I, so a column no row reaches keeps
+// its prior value 0 with a finite σ, and its Estimate carries no residual statistics: the result
+// showed relative error 0 and undetermined inertias as 0 ± 0. The batch factorisation of the same
+// rows names the columns in W's null space (σ = ∞ for them, as OLS reports them), and the
+// residual statistics are those of the recursive estimate itself.
+void rls_residual_statistics(const EquationBlock& block, const EstimationOptions& estimation,
+                             Estimate& e) {
+  const Estimate batch = ordinary_least_squares(block.W, block.y, block.group, estimation);
+  e.unidentifiable = batch.unidentifiable;
+  for (const Eigen::Index j : e.unidentifiable) {
+    e.std_dev(j) = e.relative_std_percent(j) = std::numeric_limits<double>::infinity();
+    e.ci_lower(j) = -std::numeric_limits<double>::infinity();
+    e.ci_upper(j) = std::numeric_limits<double>::infinity();
+  }
+  const Eigen::VectorXd residual = block.y - block.W * e.x;
+  const auto rows = static_cast<double>(std::max<Eigen::Index>(residual.size(), 1));
+  e.residual_rms = std::sqrt(residual.squaredNorm() / rows);
+  e.relative_error = residual.norm() / std::max(block.y.norm(), 1e-300);
+  const Eigen::Index groups = block.group.size() ? block.group.maxCoeff() + 1 : 0;
+  Eigen::VectorXd e2 = Eigen::VectorXd::Zero(groups), y2 = e2, m = e2;
+  for (Eigen::Index i = 0; i < block.group.size(); ++i) {
+    e2(block.group(i)) += residual(i) * residual(i);
+    y2(block.group(i)) += block.y(i) * block.y(i);
+    m(block.group(i)) += 1.0;
+  }
+  e.group_rows = m;
+  e.group_rms = (e2.array() / m.array()).sqrt();  // NaN for a group without rows
+  e.group_relative_error = (e2.array() / y2.array().max(1e-300)).sqrt();
+}
+
 // The block's estimate by the estimator of `options`, with the HAC sandwich when asked.
 Estimate estimate_block(const EquationBlock& block, const LoadIdentificationOptions& options,
                         Eigen::MatrixXd* history) {
@@ -389,6 +419,7 @@ Estimate estimate_block(const EquationBlock& block, const LoadIdentificationOpti
     rls.record_history = options.record_history;
     estimate = recursive_least_squares(block.W, block.y, rls, estimation,
                                        options.record_history ? history : nullptr);
+    rls_residual_statistics(block, estimation, estimate);
   }
   if (options.hac_covariance) {
     // The sandwich needs the rows the estimator solved: WLS divides group g's rows by σ_g.

@@ -399,8 +399,12 @@ Model parse_yaml_model(const std::string& yaml, const std::string& source,
   } catch (const YAML::Exception& e) {
     const std::string line =
         e.mark.is_null() ? std::string() : ", line " + std::to_string(e.mark.line + 1);
-    throw Error("robot file '" + source + "'" + line + ": " + printable(e.msg) +
-                "; check the value's type");
+    // yaml-cpp's own words ("bad conversion") name neither the value nor the fix.
+    const std::string reason = e.msg.find("bad conversion") != std::string::npos
+                                   ? "a value has the wrong type (a list or map where a name or "
+                                     "number belongs, or text where a number belongs)"
+                                   : printable(e.msg);
+    throw Error("robot file '" + source + "'" + line + ": " + reason + "; check the value's type");
   }
   model.source = source;
   model.finalize();

@@ -21,6 +21,7 @@
 #include <Eigen/Geometry>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/input_file.hpp"
 #include "dynid/common/message.hpp"
 
 namespace dynid {
@@ -30,6 +31,7 @@ std::string read_robot_file(const std::string& path) {
   if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
     throw Error("robot file '" + path + "' is a directory; give the path of a URDF or YAML file");
   }
+  require_regular_file(path, "robot file");
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
                                                        &std::fclose);
   if (!file) {
@@ -193,6 +195,15 @@ class TreeBuilder {
         case urdf::Joint::REVOLUTE:
         case urdf::Joint::CONTINUOUS:
         case urdf::Joint::PRISMATIC: {
+          if (uj.mimic) {
+            // A mimic joint moves with another one: not a degree of freedom of its own, and
+            // taken as free it would get parameters and torque columns no data can hold.
+            throw Error("joint '" + uj.name + "' in '" + source_ + "' mimics joint '" +
+                        uj.mimic->joint_name +
+                        "' (a coupled joint, not supported): every moving joint of dynid is "
+                        "independently actuated; make '" +
+                        uj.name + "' fixed, or remove its <mimic> if it has its own actuator");
+          }
           if (model_.dof() >= kMaxJoints) {
             throw Error("robot file '" + source_ + "' has more than " + std::to_string(kMaxJoints) +
                         " moving joints, the limit of dynid; split the model or make joints fixed");

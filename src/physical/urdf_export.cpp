@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/input_file.hpp"
 #include "dynid/io/urdf_writer.hpp"
 #include "dynid/model/urdf_loader.hpp"
 #include "dynid/version.hpp"
@@ -86,6 +87,7 @@ std::string print(const tinyxml2::XMLDocument& doc) {
 }  // namespace
 
 ConsistentParameterFile read_consistent_parameters(const std::string& path) {
+  require_regular_file(path, "result file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error("cannot open result file '" + path + "'; check the path");
   nlohmann::json j;

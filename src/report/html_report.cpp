@@ -8,10 +8,13 @@
 #include <sstream>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/input_file.hpp"
 #include "dynid/excitation/fourier_trajectory.hpp"
 #include "dynid/identification/integral_equations.hpp"
 #include "dynid/identification/pipeline.hpp"
 #include "dynid/io/atomic_file.hpp"
+#include "dynid/io/markup.hpp"
+#include "dynid/report/identification_report.hpp"
 #include "dynid/sim/error_statistics.hpp"
 #include "dynid/version.hpp"
 
@@ -586,24 +589,17 @@ std::string script_safe(const std::string& text) {
   return out;
 }
 
-std::string html_escaped(const std::string& text) {
+// The data block is JSON in a <script> element: every '<' written as \u003c (the same string to
+// JSON.parse), so no name or warning can end the element ("</script"), open a comment that hides
+// the page's own end tag ("<!--<script>", the HTML script-data escape states), or start a tag.
+std::string json_script_safe(const std::string& json) {
   std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '&':
-        out += "&amp;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
+  out.reserve(json.size());
+  for (char c : json) {
+    if (c == '<') {
+      out += "\\u003c";
+    } else {
+      out += c;
     }
   }
   return out;
@@ -754,11 +750,7 @@ constexpr const char* kRenderer = R"JS(
 )JS";
 
 std::string read_text(const std::string& path, const std::string& what) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(what + " '" + path + "' cannot be read");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  return read_regular_file(path, kMaxResultFileBytes, what);
 }
 
 }  // namespace
@@ -837,14 +829,14 @@ std::string html_report(const std::vector<ReportInput>& inputs, const HtmlReport
   std::string out;
   out.reserve(chart_js.size() + (1 << 16));
   out += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>";
-  out += html_escaped(options.title);
+  out += markup_escaped(options.title);
   out += "</title><style>";
   out += kStyle;
   out += "</style><script>";
   out += script_safe(chart_js);
   out += "</script></head><body data-report-status=\"loading\">\n";
   out += "<script type=\"application/json\" id=\"dynid-data\">";
-  out += script_safe(page.dump(-1, ' ', false, Json::error_handler_t::replace));
+  out += json_script_safe(page.dump(-1, ' ', false, Json::error_handler_t::replace));
   out += "</script>\n<script>";
   out += kRenderer;
   out += "</script></body></html>\n";

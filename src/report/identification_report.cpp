@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/input_file.hpp"
 #include "dynid/common/message.hpp"
 #include "dynid/io/csv_writer.hpp"
 #include "dynid/io/json_writer.hpp"
@@ -225,13 +226,15 @@ void read_completion_data(const nlohmann::json& j, const std::string& path,
 }  // namespace
 
 IdentifiedResultFile read_identification_result(const std::string& path) {
-  std::ifstream f(path);
-  if (!f)
-    throw Error("cannot open parameter file '" + path +
-                "'; give the result.json of dynid identify");
+  std::string text;
+  try {
+    text = read_regular_file(path, kMaxResultFileBytes, "parameter file");
+  } catch (const Error& e) {
+    throw Error(std::string(e.what()) + " (the result.json of dynid identify)");
+  }
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(f);
+    j = nlohmann::json::parse(text);
   } catch (const std::exception& ex) {
     throw Error("'" + path + "' is not valid JSON (" + one_line(ex.what()) + ")");
   }

@@ -1,5 +1,8 @@
 #include "dynid/signal/plausibility.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
 
@@ -12,7 +15,37 @@ std::string join(const std::vector<std::string>& items) {
   return out;
 }
 
+double median(std::vector<double>& v) {
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
 }  // namespace
+
+std::optional<CorruptSample> find_corrupt_sample(const Eigen::Ref<const Eigen::MatrixXd>& x,
+                                                 double floor) {
+  // 1.4826·MAD estimates σ of Gaussian data.
+  constexpr double kMadToSigma = 1.4826;
+  std::optional<CorruptSample> first;
+  std::vector<double> v;
+  for (Eigen::Index j = 0; j < x.cols(); ++j) {
+    if (x.rows() == 0) break;
+    v.assign(x.col(j).data(), x.col(j).data() + x.rows());
+    const double centre = median(v);
+    for (double& d : v) d = std::abs(d - centre);
+    const double limit = kCorruptSpreads * std::max(kMadToSigma * median(v), floor);
+    for (Eigen::Index k = 0; k < x.rows(); ++k) {
+      if (first && k >= first->sample) break;
+      // Written so that NaN counts as corrupt too.
+      if (!(std::abs(x(k, j) - centre) <= limit)) {
+        first = CorruptSample{k, j, x(k, j), centre, limit};
+        break;
+      }
+    }
+  }
+  return first;
+}
 
 std::vector<std::string> check_run_plausibility(const Eigen::Ref<const Eigen::VectorXd>& t,
                                                 const Eigen::Ref<const Eigen::MatrixXd>& q,

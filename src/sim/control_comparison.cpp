@@ -77,6 +77,14 @@ ControlComparison compare_control(const Model& plant_model, const Model& control
     throw Error("the reversal window must be finite and >= 0 s, got " +
                 short_number(options.reversal_window));
   const SamplingInfo info = require_uniform_sampling(t, 1e-6, "control comparison");
+  // A window as long as the period masks every sample (and costs samples × window): refused
+  // before the two simulations, not after them.
+  const double span = static_cast<double>(t.size()) / info.rate_hz();
+  if (!(options.reversal_window < span)) {
+    throw Error("the reversal window " + short_number(options.reversal_window) +
+                " s is not shorter than one period of the reference (" + short_number(span) +
+                " s); give --reversal-window below " + short_number(span));
+  }
   SimulateOptions so = options.simulate;
   so.loop.record_truth = true;
   so.feed_forward = FeedForward::kNone;

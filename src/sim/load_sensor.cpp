@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/input_file.hpp"
 #include "dynid/common/message.hpp"
 #include "dynid/dynamics/rnea.hpp"
 #include "dynid/dynamics/workspace.hpp"
@@ -59,6 +60,7 @@ std::vector<double> read_list(const YAML::Node& doc, const char* key, std::size_
 }  // namespace
 
 Eigen::VectorXd read_load_file(const std::string& path) {
+  require_regular_file(path, "load file");
   YAML::Node doc;
   try {
     doc = YAML::LoadFile(path);

@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/input_file.hpp"
 #include "dynid/common/message.hpp"
 #include "dynid/io/json_writer.hpp"
 
@@ -45,6 +46,7 @@ Eigen::VectorXd read_gain_list(const YAML::Node& doc, const char* key, const std
 }  // namespace
 
 PidGains read_pid_gains(const std::string& path, const Model& model) {
+  require_regular_file(path, "gains file");
   YAML::Node doc;
   try {
     doc = YAML::LoadFile(path);

@@ -173,6 +173,22 @@ ClosedLoopResult simulate_reference(const Model& model, const Eigen::Ref<const E
   const SamplingInfo info = require_uniform_sampling(t, 1e-6, "closed-loop simulation");
   const Reference ref = periodic_reference(t, q, dq, ddq);
   check_reference_rows(model, ref.q);
+  // Work and memory grow with periods × samples and with the delay line: bounded here, so that a
+  // mistyped count is one error line instead of a run that allocates until the machine stops.
+  const double samples = static_cast<double>(options.loop.periods) * ref.t.size();
+  if (samples > kMaxSimulatedSamples) {
+    throw Error("simulate: " + std::to_string(options.loop.periods) + " periods of " +
+                std::to_string(ref.t.size()) + " samples are " + short_number(samples) +
+                " samples, more than the " + short_number(kMaxSimulatedSamples) +
+                " a simulation may have; lower --periods");
+  }
+  const int delay = std::max(options.sensors.position_delay, options.sensors.torque_delay);
+  if (delay >= ref.t.size()) {
+    throw Error("simulate: a measurement delay of " + std::to_string(delay) +
+                " samples is not shorter than one period of the reference (" +
+                std::to_string(ref.t.size()) + " samples); give a --delay below " +
+                std::to_string(ref.t.size()));
+  }
   options.plant.dt = info.mean_period;
   const Model& controller_model = options.controller_model ? *options.controller_model : model;
   if (controller_model.dof() != model.dof())

@@ -3,6 +3,8 @@
 #include <string>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
+#include "dynid/signal/plausibility.hpp"
 
 namespace dynid {
 
@@ -21,6 +23,17 @@ SimulationValidation validate_by_simulation(const Model& identified, const Refer
                 std::to_string(tau_measured.cols()));
   if (!q_measured.allFinite() || !tau_measured.allFinite())
     throw Error("measured q or tau has NaN or Inf values: clean or trim the measured run");
+  // One corrupt sample (1e200) makes the error statistics NaN or meaningless: refused like
+  // preprocess() refuses it for a fit (the same floors: 1 rad, 1 N·m).
+  for (const auto& [x, what] : {std::pair{&q_measured, "q"}, std::pair{&tau_measured, "tau"}}) {
+    if (const std::optional<CorruptSample> c = find_corrupt_sample(*x, 1.0)) {
+      throw Error("measured " + std::string(what) + std::to_string(c->column + 1) + " at sample " +
+                  std::to_string(c->sample + 1) + " = " + short_number(c->value) +
+                  " is a corrupt sample: it lies more than " + short_number(c->limit) +
+                  " from the median " + short_number(c->median) +
+                  " of its column; remove or repair that row of the measured run");
+    }
+  }
   if (options.skip_samples < 0 || rows - options.skip_samples < 2)
     throw Error("skip_samples = " + std::to_string(options.skip_samples) +
                 " leaves fewer than 2 of " + std::to_string(rows) +

@@ -79,7 +79,8 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
   // No torque limit beyond the model's (none for puma560): an unbounded limit has no margin to
   // report, where a stand-in like 1e6 N·m dwarfed the real margins in the report's chart.
   out.excitation = optimize_excitation(model, ex);
-  write_json(file("excitation.json"), excitation_to_json(out.excitation));
+  out.reports.push_back({file("excitation.json"), excitation_to_json(out.excitation)});
+  write_json(out.reports.back().source, out.reports.back().result);
   const TrajectorySamples traj =
       sample_trajectory(FourierTrajectory(out.excitation.coefficients), o.rate, false);
   write_trajectory_csv(file("traj.csv"), traj);
@@ -162,7 +163,8 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
   result["plot"] = prediction_plot_json(
       validate_torques(model, rec, out.identification.names, out.identification.estimate.x, io),
       joint_names);
-  write_json(file("result.json"), result);
+  out.reports.push_back({file("result.json"), result});
+  write_json(out.reports.back().source, result);
 
   progress("4/6 validating on a trapezoidal move");
   Eigen::MatrixXd way(n, 3);
@@ -192,7 +194,8 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
       validate_torques(model, vrec, out.identification.names, out.identification.estimate.x, vo);
   nlohmann::json validation = validation_to_json(model, out.validation);
   validation["plot"] = prediction_plot_json(out.validation, joint_names);
-  write_json(file("validation.json"), validation);
+  out.reports.push_back({file("validation.json"), validation});
+  write_json(out.reports.back().source, validation);
 
   progress("5/6 comparing with the true parameters");
   std::ostringstream t;

@@ -18,6 +18,7 @@
 #include <sstream>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/input_file.hpp"
 #include "dynid/io/atomic_file.hpp"
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/sim/pid_gains.hpp"
@@ -93,43 +94,6 @@ std::string resolve(const std::string& value, const fs::path& project_dir) {
 
 // ---- Reading with a cap -------------------------------------------------------------------------
 
-// The whole of a regular file, at most `cap` bytes (what is read counts, not what stat says).
-// Opened without blocking, so a FIFO planted at the name is refused instead of waited on; a
-// symbolic link is followed unless `no_follow`. Throws dynid::Error "WHAT 'PATH': ...; FIX".
-std::string read_regular_file(const fs::path& path, std::size_t cap, const std::string& what,
-                              bool no_follow = false) {
-  const std::string shown = what + " '" + path.string() + "'";
-  const int fd = ::open(
-      path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY | (no_follow ? O_NOFOLLOW : 0));
-  if (fd < 0) {
-    throw Error(shown + ": cannot open (" + std::strerror(errno) + "); check the path");
-  }
-  struct Close {
-    int fd;
-    ~Close() { ::close(fd); }
-  } closer{fd};
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    throw Error(shown + " is not a regular file (a folder, device or FIFO); give a file");
-  }
-  const auto too_large = [&] {
-    throw Error(shown + " is larger than " + std::to_string(cap >> 20) +
-                " MiB, the limit for this input; give a smaller file or split it");
-  };
-  if (static_cast<std::size_t>(st.st_size) > cap) too_large();
-  std::string text;
-  char buffer[1 << 16];
-  for (;;) {
-    const ssize_t n = ::read(fd, buffer, sizeof buffer);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) throw Error(shown + ": read error (" + std::strerror(errno) + "); check the file");
-    if (n == 0) break;
-    if (text.size() + static_cast<std::size_t>(n) > cap) too_large();
-    text.append(buffer, static_cast<std::size_t>(n));
-  }
-  return text;
-}
-
 // ---- The marker of a folder dynid run wrote -----------------------------------------------------
 
 struct Marker {
@@ -144,7 +108,7 @@ Marker read_marker(const fs::path& folder) {
   std::string text;
   try {
     // Not followed: a link planted in place of the marker does not vouch for the folder.
-    text = read_regular_file(folder / kMarkerFile, std::size_t{1} << 20, "marker", true);
+    text = read_regular_file((folder / kMarkerFile).string(), std::size_t{1} << 20, "marker", true);
   } catch (const Error&) {
     return m;
   }
@@ -349,7 +313,7 @@ std::string data_file(const YAML::Node& item, const std::string& where, const fs
       throw Error(where + ": data file '" + f + "' not found (looked for " + p.string() +
                   "); give the path relative to the project file");
     }
-    texts.push_back(read_regular_file(p, kMaxCsvFileBytes, where + ": joined file"));
+    texts.push_back(read_regular_file(p.string(), kMaxCsvFileBytes, where + ": joined file"));
     total += texts.back().size();
     if (total > kMaxCsvFileBytes) {
       throw Error(where + ": the joined files are larger than " +
@@ -522,7 +486,8 @@ ProjectResult run_project(const ProjectOptions& options, const CommandTable& tab
     throw Error("project file '" + options.project_file + "' not found; give a YAML project file");
   }
   const fs::path project_dir = project.parent_path();
-  const std::string project_text = read_regular_file(project, kMaxProjectFileBytes, "project file");
+  const std::string project_text =
+      read_regular_file(project.string(), kMaxProjectFileBytes, "project file");
   YAML::Node root;
   try {
     root = YAML::Load(project_text);

@@ -4,6 +4,7 @@
 // from the planar 2R closed form (tests/support/planar2.hpp with the numbers of the built-in
 // planar2, docs/methods/model.md), not by dynid.
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -12,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <random>
 #include <sstream>
 #include <string>
 
@@ -51,7 +53,9 @@ class Contract : public ::testing::Test {
 
   /// `dynid <args>`: args are shell words (single-quote paths with odd bytes).
   CliRun run(const std::string& args) const {
-    const std::string command = std::string("'") + DYNID_BINARY + "' " + args + " >'" +
+    // `timeout`: a command that hangs (a FIFO read, unbounded work) fails its test instead of
+    // stopping the suite.
+    const std::string command = std::string("timeout 600 '") + DYNID_BINARY + "' " + args + " >'" +
                                 (dir_ / "out.txt").string() + "' 2>'" +
                                 (dir_ / "err.txt").string() + "' </dev/null";
     const int status = std::system(command.c_str());
@@ -271,6 +275,201 @@ TEST_F(Contract, SimulateOverflowAndDivergenceAreErrorsWithoutMujocoOutput) {
   EXPECT_FALSE(fs::exists(out));
   r = run("simulate --robot planar2 --periods 1 -t " + clean + " -o " + out);
   EXPECT_EQ(r.code, 0) << r.err;
+}
+
+// Issue 27 item 3: one corrupt sample gave an all-NaN result with exit 0 on every path but the
+// in-memory differential model, and one q sample of 1e155 a garbage fit blamed on the
+// excitation. Every path now refuses the sample by name, and writes nothing.
+TEST_F(Contract, CorruptSampleIsRefusedOnEveryPath) {
+  const std::string tau =
+      planar2_run("tau.csv", [](int k, double* row) { row[8] = k == 523 ? 1e200 : row[8]; });
+  const std::string q =
+      planar2_run("q.csv", [](int k, double* row) { row[1] = k == 523 ? 1e155 : row[1]; });
+  const std::string out = work("result.json");
+  for (const std::string model : {"", "--stream --filter none", "--model friction --joint 1",
+                                  "--model gravity --joint 1", "--model decoupled --joint 1"}) {
+    const bool stream = model.rfind("--stream", 0) == 0;
+    expect_error(run("identify --robot planar2 " + model + " --data " + tau + " --out " + out), 1,
+                 stream ? "'" + tau + "' data row 524: tau2 = 1e+200"
+                        : "tau2 at sample 524 (t = 5.23 s) = 1e+200 is a corrupt sample");
+    EXPECT_FALSE(fs::exists(out)) << model;
+    expect_error(run("identify --robot planar2 " + model + " --data " + q + " --out " + out), 1,
+                 stream ? "'" + q + "' data row 524: q1 = 1e+155"
+                        : "q1 at sample 524 (t = 5.23 s) = 1e+155 is a corrupt sample");
+    EXPECT_FALSE(fs::exists(out)) << model;
+  }
+  // validate's simulation statistics: the measured run is screened too.
+  const std::string clean = planar2_run("clean.csv");
+  const std::string params = work("params.json");
+  ASSERT_EQ(run("identify --robot planar2 --data " + clean + " --out " + params).code, 0);
+  std::ostringstream reference;
+  reference << "t,q1,q2,dq1,dq2,ddq1,ddq2\n";
+  std::ifstream in(clean);
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    std::stringstream fields(line);
+    std::string field;
+    for (int c = 0; c < 7 && std::getline(fields, field, ','); ++c) {
+      reference << (c ? "," : "") << field;
+    }
+    reference << '\n';
+  }
+  const std::string trajectory = write("reference.csv", reference.str());
+  const std::string json = work("validation.json");
+  expect_error(run("validate --robot planar2 --params " + params +
+                   " --mode simulation --engine native --trajectory " + trajectory + " --data " +
+                   tau + " --json " + json),
+               1, "measured tau2 at sample 524 = 1e+200 is a corrupt sample");
+  EXPECT_FALSE(fs::exists(json));
+}
+
+// Issue 27 item 4: every reader opened a FIFO and waited for a writer forever.
+TEST_F(Contract, FifoInputsAreRefusedNotWaitedOn) {
+  const std::string fifo = work("fifo.csv"), urdf = work("fifo.urdf"), out = work("r.json");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  ASSERT_EQ(::mkfifo(urdf.c_str(), 0600), 0);
+  const std::string data = planar2_run("run.csv");
+  expect_error(run("identify --robot planar2 --data " + fifo + " --out " + out), 1,
+               "not a regular file (a FIFO)");
+  expect_error(run("identify --robot " + urdf + " --data " + data + " --out " + out), 1,
+               "robot file '" + urdf + "' is not a regular file (a FIFO)");
+  expect_error(run("report --in " + fifo + " --out " + work("r.html")), 1,
+               "'" + fifo + "' is not a regular file");
+  expect_error(run("validate --robot planar2 --params " + fifo + " --data " + data), 1,
+               "is not a regular file");
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// Issue 27 item 3: a mimic joint was silently a free joint with its own parameters.
+TEST_F(Contract, MimicJointIsRefusedByName) {
+  const std::string urdf = write("mimic.urdf", R"(<?xml version="1.0"?>
+<robot name="gripper">
+  <link name="base"/>
+  <link name="a"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  <link name="b"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/><mimic joint="j1" multiplier="-1"/></joint>
+</robot>
+)");
+  expect_error(run("model --robot " + urdf), 1, "joint 'j2' in '" + urdf + "' mimics joint 'j1'");
+}
+
+// Issue 27 items 3-5: excite --f0 1e-300 wrote an absurd trajectory with exit 0, and --json was
+// left behind when the trajectory could not be written.
+TEST_F(Contract, ExciteBoundsItsWorkAndWritesBothFilesOrNeither) {
+  const std::string out = work("traj.csv"), json = work("excitation.json");
+  const std::string excite =
+      "excite --robot planar2 --harmonics 3 --velocity-limit 2 --acceleration-limit 8 "
+      "--starts 1 --max-evaluations 100 --max-time 0 ";
+  expect_error(run(excite + "--f0 1e-300 --out " + out + " --json " + json), 2,
+               "--f0 1e-300 Hz gives a period of 1e+300 s");
+  expect_error(run(excite + "--f0 0.5 --rate 1e9 --out " + out), 2, "more than the 1e+07");
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(json));
+  const CliRun r = run(excite + "--f0 0.5 --out " + work("missing/traj.csv") + " --json " + json);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("missing"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(json));
+  // A spline through 20 000 via-points: a dense solve of O(m³) did not finish.
+  std::string via = "0";
+  for (int k = 1; k < 20000; ++k) via += k % 2 ? ",0.5" : ",0";
+  const CliRun spline = run("excite --robot planar2 --family spline --joint 1 --via " + via +
+                            " --duration 20000 --rate 10 --velocity-limit 100 "
+                            "--acceleration-limit 1000 --out " +
+                            out);
+  EXPECT_EQ(spline.code, 0) << spline.err;
+}
+
+// Issue 27 item 4: simulate --periods and --delay, compare-control --reversal-window set work
+// without bound.
+TEST_F(Contract, SimulationWorkIsBounded) {
+  std::ostringstream s;
+  s << "t,q1,q2,dq1,dq2,ddq1,ddq2\n";
+  for (int k = 0; k < 200; ++k) {
+    const double t = 0.01 * k, w = 2 * M_PI / 2.0;
+    s << t << "," << 0.3 * std::sin(w * t) << "," << 0.2 * std::sin(w * t) << ","
+      << 0.3 * w * std::cos(w * t) << "," << 0.2 * w * std::cos(w * t) << ","
+      << -0.3 * w * w * std::sin(w * t) << "," << -0.2 * w * w * std::sin(w * t) << "\n";
+  }
+  const std::string reference = write("reference.csv", s.str());
+  const std::string out = work("sim.csv");
+  const std::string simulate =
+      "simulate --robot planar2 --engine native --trajectory " + reference + " --out " + out;
+  expect_error(run(simulate + " --periods 2000000000"), 1, "lower --periods");
+  expect_error(run(simulate + " --delay 2000000000"), 1, "give a --delay below 200");
+  EXPECT_FALSE(fs::exists(out));
+  const std::string params = work("params.json");
+  ASSERT_EQ(
+      run("identify --robot planar2 --data " + planar2_run("run.csv") + " --out " + params).code,
+      0);
+  expect_error(run("compare-control --robot planar2 --engine native --params " + params +
+                   " --trajectory " + reference + " --reversal-window 1e300"),
+               1, "give --reversal-window below 2");
+}
+
+// Issue 27 item 5: a '"' in a name broke the URDF dynid writes, and "<!--<script>" in a name
+// blanked the HTML report (the script data block's escape states swallowed its end tag).
+TEST_F(Contract, OddNamesKeepTheUrdfAndTheReportIntact) {
+  const std::string robot = write("odd.yaml", R"(name: 'odd"arm'
+gravity: [0, -9.81, 0]
+joints:
+  - {name: 'sh"oulder<!--<script>', link: 'upper"arm&', sigma: 0, alpha: 0, d: 0, theta: 0, r: 0,
+     mass: 2.0, com: [0.5, 0, 0], inertia_com: [0, 0, 0, 0.16666666666666666, 0, 0.16666666666666666]}
+  - {name: elbow, link: forearm, sigma: 0, alpha: 0, d: 1.0, theta: 0, r: 0,
+     mass: 1.5, com: [0.4, 0, 0], inertia_com: [0, 0, 0, 0.08, 0, 0.08]}
+)");
+  const std::string result = work("result.json");
+  // Seeded torque noise: noiseless torques give intervals so narrow that no physically
+  // consistent set lies inside them.
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  const std::string run_csv = planar2_run("run.csv", [&](int, double* row) {
+    row[7] += noise(rng);
+    row[8] += noise(rng);
+  });
+  const CliRun fit = run("identify --physical --friction none --no-armature --robot " + robot +
+                         " --data " + run_csv + " --out " + result);
+  ASSERT_EQ(fit.code, 0) << fit.err;
+  const std::string urdf = work("odd.urdf");
+  const CliRun exported = run("export --robot " + robot + " --params " + result + " --out " + urdf);
+  ASSERT_EQ(exported.code, 0) << exported.err;
+  const CliRun back = run("model --robot " + urdf);
+  EXPECT_EQ(back.code, 0) << back.err;
+  EXPECT_NE(back.out.find("sh\"oulder<!--<script>"), std::string::npos) << back.out;
+  const std::string html = work("report.html");
+  ASSERT_EQ(run("report --in " + result + " --out " + html).code, 0);
+  const std::string page = slurp(html);
+  const std::string open = "id=\"dynid-data\">";
+  const auto begin = page.find(open);
+  ASSERT_NE(begin, std::string::npos);
+  const auto end = page.find("</script>", begin);
+  ASSERT_NE(end, std::string::npos);
+  const std::string data = page.substr(begin + open.size(), end - begin - open.size());
+  // No '<' at all inside the data block: no comment, tag or end tag can start there.
+  EXPECT_EQ(data.find('<'), std::string::npos) << data.substr(0, 200);
+  // The same text to JSON.parse: the name is there as it was given.
+  EXPECT_NE(nlohmann::json::parse(data).dump().find("sh\\\"oulder<!--<script>"), std::string::npos);
+}
+
+// Issue 27 item 5: a failed demo left its folder and first files behind.
+TEST_F(Contract, FailedDemoLeavesNoFileBehind) {
+  const std::string folder = work("demo");
+  const CliRun r = run("demo --robot " + work("no_such_robot.urdf") + " --out " + folder);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_FALSE(fs::exists(folder));
+}
+
+// Issue 27 item 5: yaml-cpp's "bad conversion" reached the user as the reason.
+TEST_F(Contract, WrongYamlTypeIsNamedInDynidsWords) {
+  const std::string robot = write("typed.yaml", R"(name: [not, a, name]
+joints:
+  - {name: j1, sigma: 0, alpha: 0, d: 0, theta: 0, r: 0, mass: 1.0, com: [0.5, 0, 0],
+     inertia_com: [0, 0, 0, 0.1, 0, 0.1]}
+)");
+  const CliRun r = run("model --robot " + robot);
+  expect_error(r, 1, "a value has the wrong type");
+  EXPECT_EQ(r.err.find("bad conversion"), std::string::npos) << r.err;
 }
 
 }  // namespace

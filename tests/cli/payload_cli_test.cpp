@@ -204,6 +204,19 @@ TEST_F(PayloadCli, RecursiveEstimatorWritesItsHistory) {
   const std::string history = testing::slurp(dir_ / "history.csv");
   EXPECT_EQ(history.rfind("row,m,mcx,mcy,mcz,Ixx", 0), 0u) << history.substr(0, 80);
   EXPECT_NEAR(json("load.json").at("mass").get<double>(), 1.910, 0.02);
+  // The recursive estimate carries its residual statistics (issue 27 item 3: it reported a
+  // relative error of 0). The run has wrench noise of 0.05 N and 0.003 N·m, so the residual is
+  // not 0 and not the whole wrench.
+  const double relative_error = json("load.json").at("relative_error").get<double>();
+  EXPECT_GT(relative_error, 0.0);
+  EXPECT_LT(relative_error, 0.1);
+  EXPECT_GT(json("load.json").at("residual_rms").get<double>(), 0.0);
+  // A history that cannot be written leaves no result behind (it was written first).
+  fs::remove(dir_ / "load.json");
+  const auto missing = run("payload --robot puma560 --sensor-link link6 --data " + path("run.csv") +
+                           " --sensor-pose '0.01 0 0.05 0 0 0.3' --estimator rls --history " +
+                           path("missing/history.csv") + " --out " + path("load.json"));
+  expect_error(missing, 1, "missing");
   // --report: a page headless Chromium renders without a script error or an empty chart.
   const testing::RenderedReport page = testing::render_in_chromium(path("load.html"), dir_);
   ASSERT_EQ(page.sections.size(), 1u) << page.log;

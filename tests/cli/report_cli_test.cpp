@@ -199,7 +199,7 @@ TEST_F(ReportCli, BadInputsGiveOneErrorLineAndNoPage) {
   std::ofstream(path("broken.json")) << "{\"parameters\": [";
   std::ofstream(path("list.json")) << "[1, 2]";
   const std::pair<std::string, std::string> cases[] = {
-      {"report --in " + path("missing.json") + " --out " + path("r.html"), "cannot be read"},
+      {"report --in " + path("missing.json") + " --out " + path("r.html"), "cannot open"},
       {"report --in " + path("broken.json") + " --out " + path("r.html"), "is not valid JSON"},
       {"report --in " + path("list.json") + " --out " + path("r.html"), "not an object"},
       {"report --in " + dir_.string() + " --out " + path("r.html"), "is a folder"},

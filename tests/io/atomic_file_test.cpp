@@ -218,5 +218,37 @@ TEST(AtomicFile, AnIgnoredSignalStaysIgnored) {
   EXPECT_EQ(slurp(dir.file("a.txt")), "a");
 }
 
+// OutputBatch (issue 27 item 5): the outputs of one command appear together or not at all.
+TEST(AtomicFile, BatchRenamesOnlyOnCommitAndRemovesEverythingOtherwise) {
+  TempDir dir;
+  const std::string old = dir.write("b.json", "old b\n");
+  {
+    OutputBatch batch;
+    write_text_atomic(dir.file("a.json"), "new a\n");
+    write_text_atomic(old, "new b\n");
+    EXPECT_FALSE(fs::exists(dir.file("a.json")));  // pending until commit
+    EXPECT_EQ(slurp(old), "old b\n");
+    EXPECT_EQ(temporary_files_in_flight(), 2);
+    // A later output whose folder is missing: the command fails before commit.
+    EXPECT_NE(error_of([&] { write_text_atomic(dir.file("missing/c.json"), "c\n"); }), "");
+  }
+  EXPECT_FALSE(fs::exists(dir.file("a.json")));
+  EXPECT_EQ(slurp(old), "old b\n");
+  EXPECT_EQ(dir.entries(), 1);  // b.json only: no temporary file left
+  EXPECT_EQ(temporary_files_in_flight(), 0);
+  {
+    OutputBatch batch;
+    write_text_atomic(dir.file("a.json"), "new a\n");
+    write_text_atomic(old, "new b\n");
+    batch.commit();
+  }
+  EXPECT_EQ(slurp(dir.file("a.json")), "new a\n");
+  EXPECT_EQ(slurp(old), "new b\n");
+  EXPECT_EQ(dir.entries(), 2);
+  EXPECT_EQ(temporary_files_in_flight(), 0);
+  write_text_atomic(dir.file("c.json"), "c\n");  // no batch open: written at once
+  EXPECT_EQ(slurp(dir.file("c.json")), "c\n");
+}
+
 }  // namespace
 }  // namespace dynid

@@ -73,5 +73,32 @@ TEST(Plausibility, ZeroTorquesAndStillRuns) {
   EXPECT_NE(e.find("the run does not move"), std::string::npos) << e;
 }
 
+// find_corrupt_sample (issue 27 item 3): one sample of 1e200 in a torque column, or 1e155 in a
+// position column, is found; a real run's extremes (a sine's peaks, a joint held still and then
+// moved) are not. Oracle: samples injected at known rows.
+TEST(Plausibility, CorruptSampleIsFoundAndRealMotionIsNot) {
+  Log r = run(100.0, 1.0, 2000);
+  EXPECT_FALSE(find_corrupt_sample(r.q, 1.0));
+  EXPECT_FALSE(find_corrupt_sample(r.tau, 1.0));
+  // Held still for 90 % of the run (MAD 0), then a 3 rad move: the floor keeps it plausible.
+  Eigen::MatrixXd held = Eigen::MatrixXd::Zero(2000, 1);
+  held.bottomRows(200).setConstant(3.0);
+  EXPECT_FALSE(find_corrupt_sample(held, 1.0));
+  r.tau(523, 1) = 1e200;
+  r.q(900, 0) = 1e155;
+  const auto tau = find_corrupt_sample(r.tau, 1.0);
+  ASSERT_TRUE(tau);
+  EXPECT_EQ(tau->sample, 523);
+  EXPECT_EQ(tau->column, 1);
+  EXPECT_EQ(tau->value, 1e200);
+  const auto q = find_corrupt_sample(r.q, 1.0);
+  ASSERT_TRUE(q);
+  EXPECT_EQ(q->sample, 900);
+  EXPECT_EQ(q->column, 0);
+  // The first by row: a later row of another column does not hide it.
+  r.q(1500, 1) = -1e100;
+  EXPECT_EQ(find_corrupt_sample(r.q, 1.0)->sample, 900);
+}
+
 }  // namespace
 }  // namespace dynid

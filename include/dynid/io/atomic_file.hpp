@@ -3,6 +3,7 @@
 #include <functional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 namespace dynid {
 
@@ -33,6 +34,28 @@ void write_text_atomic(const std::string& path, const std::string& text);
 /// must not replace: a directory, a device node, a FIFO or a socket. `flag` ("--out", or empty)
 /// is named in the message. write_file_atomic calls it; commands may call it before their work.
 void check_output_target(const std::string& path, const std::string& flag = "");
+
+/// The outputs of one command, all or none: while a batch is open on this thread,
+/// write_file_atomic writes each file completely to its temporary file but postpones the rename
+/// to commit(), which renames them in the order they were written. A batch destroyed without
+/// commit() (an exception between two outputs: a later file's folder is missing, a later step
+/// fails) removes every temporary file, so no output of the command appears. A rename that fails
+/// inside commit() (the file system refuses after every write succeeded) can leave the earlier
+/// ones in place. Batches do not nest: opening one while another is open throws dynid::Error.
+class OutputBatch {
+ public:
+  OutputBatch();
+  ~OutputBatch();
+  OutputBatch(const OutputBatch&) = delete;
+  OutputBatch& operator=(const OutputBatch&) = delete;
+  /// Renames every pending file into place. Throws dynid::Error as write_file_atomic's rename.
+  void commit();
+
+  struct Pending;  ///< a file written to its temporary name (atomic_file.cpp)
+
+ private:
+  std::vector<Pending>* pending_;
+};
 
 /// Number of temporary files write_file_atomic is writing right now (all threads); for tests.
 int temporary_files_in_flight();

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -50,6 +51,10 @@ struct IdentifiedResultFile {
   std::string experiment;
   int experiment_joint = 0;
 };
+
+/// Largest result JSON the readers take (read_identification_result, dynid report --in): a result
+/// with its plots is a few MB; a larger file is not one dynid wrote.
+inline constexpr std::size_t kMaxResultFileBytes = std::size_t{256} << 20;
 
 /// Reads a result JSON (identification_to_json). Throws dynid::Error naming the file when
 /// `parameters` is missing or malformed, or a stored threshold is not a non-negative number.

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,5 +28,34 @@ std::vector<std::string> check_run_plausibility(const Eigen::Ref<const Eigen::Ve
                                                 const Eigen::Ref<const Eigen::MatrixXd>& tau,
                                                 const std::vector<std::string>& joints,
                                                 const PlausibilityOptions& options = {});
+
+/// One sample of a column that no robot run holds (find_corrupt_sample()).
+struct CorruptSample {
+  Eigen::Index sample = 0;  ///< row (0-based)
+  Eigen::Index column = 0;  ///< column (0-based)
+  double value = 0.0;       ///< the sample
+  double median = 0.0;      ///< median of its column
+  double limit = 0.0;       ///< the largest distance from the median a sample may have
+};
+
+/// Distance from its column's median, in units of max(1.4826·MAD of the column, `floor`), beyond
+/// which a sample is corrupt: a run's samples spread over a few MADs; one 1e4 MADs away is a
+/// logging fault, and its square (1e200 N·m, 1e155 rad through two derivatives) overflows the
+/// normal equations into an all-NaN fit.
+constexpr double kCorruptSpreads = 1e4;
+
+/// The first sample (by row, then column) of x (m × n) further than kCorruptSpreads ×
+/// max(1.4826·MAD_j, floor) from the median of its column j, or none. `floor` [the column's unit]
+/// keeps a column that is mostly constant (MAD 0) from flagging its few real moves. No throw.
+std::optional<CorruptSample> find_corrupt_sample(const Eigen::Ref<const Eigen::MatrixXd>& x,
+                                                 double floor);
+
+/// Magnitudes no sample of a run in SI units reaches, for the paths that cannot see a whole
+/// column (identify --stream reads each row once): beyond them a sample is corrupt, and its
+/// square overflows the accumulated normal equations.
+constexpr double kMaxPlausiblePosition = 1e6;      ///< |q| [rad or m]: 1.6e5 turns
+constexpr double kMaxPlausibleVelocity = 1e6;      ///< |dq| [rad/s or m/s]
+constexpr double kMaxPlausibleAcceleration = 1e9;  ///< |ddq| [rad/s² or m/s²]
+constexpr double kMaxPlausibleTorque = 1e9;        ///< |tau| [N·m or N]
 
 }  // namespace dynid

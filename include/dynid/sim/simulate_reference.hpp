@@ -35,6 +35,9 @@ struct PidGains {
 };
 
 /// Options of simulate_reference().
+/// Most samples simulate_reference() runs (periods × samples of the period): 1e7, 28 h at 100 Hz.
+inline constexpr double kMaxSimulatedSamples = 1e7;
+
 struct SimulateOptions {
   PlantOptions plant;      ///< engine (native or MuJoCo); dt is set from the reference
   SensorOptions sensors;   ///< quantisation, noise, delays
@@ -61,7 +64,8 @@ PidOptions simulation_pid_options(const Model& model, const Eigen::Ref<const Eig
 /// reference: a non-finite logged value (noise that overflows, a plant gone unstable) or a joint
 /// leaving [P1 − span − π, P99 + span + π], P1/P99 the reference's percentiles, span = P99 − P1.
 /// When controller_used is not null it receives the controller options the run used. Throws
-/// dynid::Error when options.controller_model has another joint count than `model`.
+/// dynid::Error when options.controller_model has another joint count than `model`, when periods ×
+/// samples exceed kMaxSimulatedSamples, or a sensor delay is not shorter than one period.
 ClosedLoopResult simulate_reference(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& t,
                                     const Eigen::Ref<const Eigen::MatrixXd>& q,
                                     const Eigen::Ref<const Eigen::MatrixXd>& dq,

@@ -2,10 +2,12 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "dynid/excitation/excitation_optimization.hpp"
 #include "dynid/identification/identify.hpp"
 #include "dynid/identification/validation.hpp"
+#include "dynid/report/html_report.hpp"
 
 namespace dynid {
 
@@ -32,6 +34,10 @@ struct DemoResult {
   ExcitationResult excitation;
   ValidationResult validation;  ///< torque prediction on a trapezoidal move
   std::string table;            ///< the printed summary
+  /// The JSON files written, as read_report_input() would read them back: excitation.json,
+  /// result.json, validation.json (the caller's report needs no file, so a batch of pending
+  /// outputs, io/atomic_file.hpp, can hold them until everything has succeeded).
+  std::vector<ReportInput> reports;
 };
 
 /// Runs the whole loop on a simulated robot: optimise an excitation (condition number), run it for
