@@ -426,6 +426,8 @@ nlohmann::json payload_from_torques(const Model& model, const std::string& link_
   LoadIdentificationResult r;
   std::vector<std::pair<std::string, std::string>> choices;
   std::string reference_text;
+  // With a result reference: what its prediction took from the nominal model.
+  nlohmann::json filled = nlohmann::json::object();
   if (reference.contains("parameters")) {  // an identify() result of the unloaded robot
     if (kw.contains("cutoff_hz") || kw.contains("filter")) {
       throw py::value_error(
@@ -445,6 +447,7 @@ nlohmann::json payload_from_torques(const Model& model, const std::string& link_
                                                  predicted.predicted,
                                                  predicted.zero_velocity_threshold, options);
       choices = predicted.choices;
+      filled = {{"completed", predicted.completed}, {"filled_share", predicted.filled_share}};
     }
     if (identified.options.contains("torque_scale") &&
         !identified.options["torque_scale"].empty()) {
@@ -504,6 +507,7 @@ nlohmann::json payload_from_torques(const Model& model, const std::string& link_
   context.frame = {
       {"robot", model.name}, {"link", model.joints[link].link_name}, {"frame", frame_text}};
   context.extra = {{"reference", reference_text}, {"determined_by_torques", determined}};
+  context.extra.update(filled);
   context.group_names = joints;
   context.choices = choices;
   return payload_to_json(r, context);
