@@ -15,6 +15,7 @@
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
+#include "dynid/identification/cutoff_selection.hpp"
 #include "dynid/identification/identify.hpp"
 #include "dynid/identification/validation.hpp"
 #include "dynid/io/atomic_file.hpp"
@@ -191,11 +192,16 @@ void run_payload_from_torques(const PayloadCliOptions& cli, LoadIdentificationOp
   if (json_reference) return run_payload_from_result(cli, options, model, link, frame, file);
   const JointRecord loaded_raw = read_joint_record(cli.data, model, file);
   const JointRecord unloaded_raw = read_joint_record(cli.reference, model, file);
-  SignalOptions signal;
-  signal.filter = !cli.no_filter;
-  signal.cutoff_hz = cli.cutoff;
+  // The automatic cut-off of identify (held-out torque prediction) on the unloaded run, for both.
+  IdentifyOptions identify;
+  identify.layout = ParameterLayout::full();
+  identify.signal.filter = !cli.no_filter;
+  identify.signal.cutoff_hz = cli.cutoff;
+  const CutoffSelection cutoff = select_cutoff(model, unloaded_raw, identify);
+  const SignalOptions signal = cutoff.signal;
   std::vector<std::pair<std::string, std::string>> choices, reference_choices;
   const JointRecord loaded = preprocess(loaded_raw, signal, choices).record;
+  echo_cutoff_selection(cutoff, choices);
   const JointRecord unloaded = preprocess(unloaded_raw, signal, reference_choices).record;
   // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
   options.hac_covariance = signal.filter;
@@ -312,7 +318,11 @@ void run_payload(const PayloadCliOptions& cli) {
       SignalOptions signal;
       signal.filter = !cli.no_filter;
       signal.cutoff_hz = cli.cutoff;
-      PreparedLoadRun run = prepare_load_run(record, wrench, signal, choices);
+      // The automatic cut-off by held-out prediction of the wrench, as identify chooses its own.
+      const CutoffSelection cutoff =
+          select_load_cutoff(model, mount, record, wrench, signal, equations);
+      PreparedLoadRun run = prepare_load_run(record, wrench, cutoff.signal, choices);
+      echo_cutoff_selection(cutoff, choices);
       // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
       options.hac_covariance = signal.filter;
       wrench = std::move(run.wrench);

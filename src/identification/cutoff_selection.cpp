@@ -22,49 +22,41 @@ struct HeldOutError {
   bool ok = false;     // false when a fold had too few rows for the base parameters
 };
 
-// Two-fold cross-validation over alternate blocks of samples (see select_cutoff): fit on the
-// candidate's processing (W_fit, p), predict with the reference processing (W_ref, tau_ref).
-HeldOutError held_out_error(const Eigen::MatrixXd& W_fit, const ProcessedRecord& p,
-                            const Eigen::MatrixXd& W_ref, const Eigen::MatrixXd& tau_ref,
-                            const std::vector<int>& base, const Eigen::VectorXd& zero_velocity,
-                            int blocks, Eigen::Index guard) {
-  const Eigen::Index m = p.record.t.size(), n = p.record.q.cols();
-  const auto rank = static_cast<Eigen::Index>(base.size());
+// Two-fold cross-validation over alternate blocks of samples (see select_cutoff_held_out): fit on
+// the candidate's equations, predict with the reference equations (those at the upper bound).
+HeldOutError held_out_error(const CutoffEquations& fit_eq, const CutoffEquations& ref,
+                            Eigen::Index samples, int blocks, Eigen::Index guard) {
+  const Eigen::Index m = samples, p = fit_eq.W.cols();
   const auto block_of = [&](Eigen::Index k) { return k * blocks / m; };
   double e2 = 0.0, y2 = 0.0;
   for (int fold = 0; fold < 2; ++fold) {
     std::vector<Eigen::Index> fit;
-    for (Eigen::Index k = 0; k < m; ++k) {
-      if (block_of(k) % 2 != fold) continue;
-      for (Eigen::Index j = 0; j < n; ++j) {
-        if (zero_velocity.size() && std::abs(p.record.dq(k, j)) < zero_velocity[j]) continue;
-        fit.push_back(k * n + j);
-      }
+    for (Eigen::Index i = 0; i < fit_eq.y.size(); ++i) {
+      if (block_of(fit_eq.sample[i]) % 2 != fold) continue;
+      if (!fit_eq.fitted.empty() && !fit_eq.fitted[static_cast<size_t>(i)]) continue;
+      fit.push_back(i);
     }
-    if (static_cast<Eigen::Index>(fit.size()) <= 2 * rank) return {};
-    Eigen::MatrixXd A(static_cast<Eigen::Index>(fit.size()), rank);
+    if (static_cast<Eigen::Index>(fit.size()) <= 2 * p) return {};
+    Eigen::MatrixXd A(static_cast<Eigen::Index>(fit.size()), p);
     Eigen::VectorXd b(A.rows());
     for (Eigen::Index i = 0; i < A.rows(); ++i) {
-      for (Eigen::Index c = 0; c < rank; ++c) A(i, c) = W_fit(fit[i], base[c]);
-      b[i] = p.record.tau(fit[i] / n, fit[i] % n);
+      A.row(i) = fit_eq.W.row(fit[static_cast<size_t>(i)]);
+      b[i] = fit_eq.y[fit[static_cast<size_t>(i)]];
     }
     const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
-    if (qr.rank() < rank) return {};
+    if (qr.rank() < p) return {};
     const Eigen::VectorXd theta = qr.solve(b);
-    for (Eigen::Index k = 0; k < m; ++k) {
+    for (Eigen::Index i = 0; i < ref.y.size(); ++i) {
+      const Eigen::Index k = ref.sample[i];
       const Eigen::Index blk = block_of(k);
       if (blk % 2 == fold) continue;
       // Distance to the nearest boundary of this block: samples near it are not predicted.
       const Eigen::Index first = (blk * m + blocks - 1) / blocks;
       const Eigen::Index next = ((blk + 1) * m + blocks - 1) / blocks;
       if ((blk > 0 && k - first < guard) || (blk + 1 < blocks && next - k <= guard)) continue;
-      for (Eigen::Index j = 0; j < n; ++j) {
-        double pred = 0.0;
-        for (Eigen::Index c = 0; c < rank; ++c) pred += W_ref(k * n + j, base[c]) * theta[c];
-        const double e = tau_ref(k, j) - pred;
-        e2 += e * e;
-        y2 += tau_ref(k, j) * tau_ref(k, j);
-      }
+      const double e = ref.y[i] - ref.W.row(i).dot(theta);
+      e2 += e * e;
+      y2 += ref.y[i] * ref.y[i];
     }
   }
   if (!(y2 > 0.0)) return {};
@@ -92,14 +84,13 @@ std::string percent(double fraction) {
 
 }  // namespace
 
-CutoffSelection select_cutoff(const Model& model, const JointRecord& record,
-                              const IdentifyOptions& options,
-                              const CutoffSelectionOptions& selection) {
-  check_signal_options(options.signal);  // a NaN cut-off is no request for the automatic one
+CutoffSelection select_cutoff_held_out(const JointRecord& record, const SignalOptions& signal,
+                                       const CutoffEquationBuilder& build, const std::string& what,
+                                       const CutoffSelectionOptions& selection) {
+  check_signal_options(signal);  // a NaN cut-off is no request for the automatic one
   CutoffSelection out;
-  out.signal = options.signal;
-  if (!options.signal.filter || options.signal.cutoff_hz > 0.0) return out;
-  if (record.q.cols() != model.dof()) return out;  // preprocess_run() reports it
+  out.signal = signal;
+  if (!signal.filter || signal.cutoff_hz > 0.0) return out;
   if (selection.blocks < 2 || selection.blocks % 2 != 0 || !(selection.grid_ratio > 1.0)) {
     throw Error("select_cutoff: blocks must be even and >= 2 and grid_ratio > 1");
   }
@@ -121,7 +112,7 @@ CutoffSelection select_cutoff(const Model& model, const JointRecord& record,
     spectral_reason = c.reason;
   } else {
     std::vector<std::pair<std::string, std::string>> spectral_choices;
-    SignalOptions probe = options.signal;
+    SignalOptions probe = signal;
     probe.decimate = 1;
     probe.trim = 0;
     const ProcessedRecord spectral = preprocess(record, probe, spectral_choices);
@@ -130,11 +121,26 @@ CutoffSelection select_cutoff(const Model& model, const JointRecord& record,
     for (const auto& c : spectral_choices)
       if (c.first == "cutoff") spectral_reason = c.second;
   }
-  const double f_s = three_digits(spectral_hz);
-  out.signal.cutoff_hz = f_s;
-  out.selected = true;
   const CutoffRule rule;
   const double hi = three_digits(std::min(rule.max_hz, rule.max_fraction_of_rate * rate));
+  double lowest = spectral_hz;
+  if (selection.regressor_degree > 1) {
+    // The products of the motion reach degree·f_b: pass them to within 1e-3 of their amplitude.
+    const double pass = std::pow(1e-3, 1.0 / (2.0 * std::max(1, signal.order)));
+    const double needed = selection.regressor_degree * spectral_hz / rule.margin / pass;
+    if (needed > lowest) {
+      lowest = std::min(needed, hi);
+      std::ostringstream n;
+      n << std::setprecision(3) << "; raised to " << lowest << " Hz so that the products of the "
+        << "motion in the equations (degree " << selection.regressor_degree << ", up to "
+        << selection.regressor_degree * spectral_hz / rule.margin
+        << " Hz) pass the filter within 0.1 %";
+      spectral_reason += n.str();
+    }
+  }
+  const double f_s = three_digits(lowest);
+  out.signal.cutoff_hz = f_s;
+  out.selected = true;
   std::ostringstream why;
   why << std::setprecision(3);
   if (f_s >= hi * (1.0 - 1e-12)) {
@@ -151,7 +157,7 @@ CutoffSelection select_cutoff(const Model& model, const JointRecord& record,
   // One trim (the lowest cut-off's, which has the longest transient) and one decimation (the
   // highest cut-off's) for every candidate, so that all predict the same samples.
   const Eigen::Index m_in = record.t.size();
-  SignalOptions common = options.signal;
+  SignalOptions common = signal;
   if (common.trim < 0) {
     const auto cap = static_cast<int>(std::max<Eigen::Index>(0, (m_in - 10) / 4));
     common.trim = std::min(cap, static_cast<int>(std::ceil(3.0 * rate / grid.front())));
@@ -159,39 +165,30 @@ CutoffSelection select_cutoff(const Model& model, const JointRecord& record,
   if (common.decimate <= 0) {
     common.decimate = std::max(1, static_cast<int>(std::floor(rate / (10.0 * hi))));
   }
-  const bool coupling = options.coupling && !coupled_motors(model).empty();
-  BaseParameterOptions bo = options.base;
-  bo.layout = options.layout;
-  bo.coupling = coupling;
-  const BaseParameters base = compute_base_parameters(model, bo);
-  const Eigen::VectorXd zero_velocity =
-      options.layout.coulomb ? given_zero_velocity(options.signal.zero_velocity, model.dof())
-                             : Eigen::VectorXd();
-
-  auto process = [&](double f) {
-    std::vector<std::pair<std::string, std::string>> ignored;
+  auto equations = [&](double f) {
     SignalOptions s = common;
     s.cutoff_hz = f;
-    return preprocess(record, s, ignored);
+    return build(s);
   };
   try {
     // Every candidate's parameters predict the same held-out samples from the same signals: the
     // record processed at the upper bound (lightly filtered), so a candidate that smooths its own
-    // torque gains nothing from it, and only the parameters differ.
-    const ProcessedRecord reference = process(hi);
-    const Eigen::MatrixXd W_ref = processed_regressor(model, options.layout, coupling, reference);
-    const Eigen::Index m = reference.record.t.size();
+    // y gains nothing from it, and only the parameters differ.
+    const CutoffEquations reference = equations(hi);
+    if (reference.y.size() == 0 || reference.sample.size() != reference.y.size())
+      throw Error("no equations to compare");
+    const Eigen::Index m = reference.sample.maxCoeff() + 1;
+    const double kept_rate = rate / common.decimate;
     const auto guard = std::min<Eigen::Index>(
-        m / selection.blocks / 4, static_cast<Eigen::Index>(std::ceil(
-                                      selection.guard_periods / grid.front() * reference.rate_hz)));
+        m / selection.blocks / 4,
+        static_cast<Eigen::Index>(std::ceil(selection.guard_periods / grid.front() * kept_rate)));
     double best = INFINITY;
     for (double f : grid) {
-      const bool is_ref = f == hi;
-      const ProcessedRecord p = is_ref ? reference : process(f);
-      const Eigen::MatrixXd W =
-          is_ref ? W_ref : processed_regressor(model, options.layout, coupling, p);
-      const HeldOutError h = held_out_error(W, p, W_ref, reference.record.tau, base.base,
-                                            zero_velocity, selection.blocks, guard);
+      const CutoffEquations e = f == hi ? reference : equations(f);
+      if (e.y.size() != reference.y.size() || e.W.cols() != reference.W.cols() ||
+          e.sample != reference.sample)
+        throw Error("the candidates' equations do not share their rows");
+      const HeldOutError h = held_out_error(e, reference, m, selection.blocks, guard);
       if (!h.ok) {
         out.candidates.clear();
         break;
@@ -212,19 +209,65 @@ CutoffSelection select_cutoff(const Model& model, const JointRecord& record,
     out.signal.cutoff_hz = f_s;
     out.reason = spectral_reason +
                  "; held-out selection not possible (a half of the blocks does not determine the "
-                 "base parameters)";
+                 "parameters)";
     return out;
   }
-  why << "auto: " << out.signal.cutoff_hz
-      << " Hz, the lowest torque prediction error on held-out samples (fit on alternate "
-      << selection.blocks / 2 << " of " << selection.blocks
-      << " blocks, predict the others from q and tau filtered at " << hi << " Hz):";
+  why << "auto: " << out.signal.cutoff_hz << " Hz, the lowest " << what
+      << " prediction error on held-out samples (fit on alternate " << selection.blocks / 2
+      << " of " << selection.blocks << " blocks, predict the others from the signals filtered at "
+      << hi << " Hz):";
   for (const CutoffCandidate& c : out.candidates) {
     why << " " << c.cutoff_hz << " Hz " << percent(c.held_out_error) << ";";
   }
   why << " lowest candidate from the spectral rule: " << spectral_reason;
   out.reason = why.str();
   return out;
+}
+
+CutoffSelection select_cutoff(const Model& model, const JointRecord& record,
+                              const IdentifyOptions& options,
+                              const CutoffSelectionOptions& selection) {
+  if (record.q.cols() != model.dof()) {  // preprocess_run() reports it
+    check_signal_options(options.signal);
+    CutoffSelection out;
+    out.signal = options.signal;
+    return out;
+  }
+  const bool coupling = options.coupling && !coupled_motors(model).empty();
+  BaseParameterOptions bo = options.base;
+  bo.layout = options.layout;
+  bo.coupling = coupling;
+  const BaseParameters base = compute_base_parameters(model, bo);
+  const Eigen::VectorXd zero_velocity =
+      options.layout.coulomb ? given_zero_velocity(options.signal.zero_velocity, model.dof())
+                             : Eigen::VectorXd();
+  const auto rank = static_cast<Eigen::Index>(base.base.size());
+  // The joint-torque equations on the base columns, sample-major; near-still Coulomb rows (a
+  // given zero-velocity threshold) are not fitted, as identify() leaves them out.
+  const CutoffEquationBuilder build = [&](const SignalOptions& s) {
+    std::vector<std::pair<std::string, std::string>> ignored;
+    const ProcessedRecord p = preprocess(record, s, ignored);
+    const Eigen::MatrixXd W = processed_regressor(model, options.layout, coupling, p);
+    const Eigen::Index m = p.record.t.size(), n = p.record.q.cols();
+    CutoffEquations e;
+    e.W.resize(m * n, rank);
+    e.y.resize(m * n);
+    e.sample.resize(m * n);
+    e.fitted.assign(static_cast<size_t>(m * n), true);
+    for (Eigen::Index k = 0; k < m; ++k) {
+      for (Eigen::Index j = 0; j < n; ++j) {
+        const Eigen::Index row = k * n + j;
+        for (Eigen::Index c = 0; c < rank; ++c)
+          e.W(row, c) = W(row, base.base[static_cast<size_t>(c)]);
+        e.y[row] = p.record.tau(k, j);
+        e.sample[row] = static_cast<int>(k);
+        if (zero_velocity.size() && std::abs(p.record.dq(k, j)) < zero_velocity[j])
+          e.fitted[static_cast<size_t>(row)] = false;
+      }
+    }
+    return e;
+  };
+  return select_cutoff_held_out(record, options.signal, build, "torque", selection);
 }
 
 void echo_cutoff_selection(const CutoffSelection& selection,

@@ -481,6 +481,30 @@ Estimate slice(const Estimate& e, Eigen::Index first, Eigen::Index count) {
 
 }  // namespace
 
+CutoffSelection select_load_cutoff(const Model& model, const SensorMount& mount,
+                                   const JointRecord& record,
+                                   const Eigen::Ref<const Eigen::MatrixXd>& wrench,
+                                   const SignalOptions& signal,
+                                   const LoadEquationOptions& equations,
+                                   const CutoffSelectionOptions& selection) {
+  const Eigen::MatrixXd reading = wrench;
+  const CutoffEquationBuilder build = [&](const SignalOptions& s) {
+    std::vector<std::pair<std::string, std::string>> ignored;
+    const PreparedLoadRun run = prepare_load_run(record, reading, s, ignored);
+    const EquationBlock block =
+        load_equations(sensor_motion_from_joints(model, run.record, mount), run.wrench, equations);
+    CutoffEquations e;
+    e.W = block.W;
+    e.y = block.y;
+    e.sample = block.sample;
+    return e;
+  };
+  // The load's equations hold ω×(ω×c) and ω×(I·ω): products of two motion signals.
+  CutoffSelectionOptions products = selection;
+  products.regressor_degree = std::max(products.regressor_degree, 2);
+  return select_cutoff_held_out(record, signal, build, "wrench", products);
+}
+
 LoadIdentificationResult identify_load(const EquationBlock& block,
                                        const LoadIdentificationOptions& options) {
   LoadIdentificationResult out;
