@@ -118,7 +118,7 @@ ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& option
   if (options.torque_time_offset != 0.0) {
     if (!std::isfinite(options.torque_time_offset) ||
         std::abs(options.torque_time_offset) * rate > 100.0) {
-      throw UsageError("--torque-offset " + fmt(options.torque_time_offset) +
+      throw UsageError("--time-shift " + fmt(options.torque_time_offset) +
                        " s is not a small finite time (at most 100 samples); give e.g. " +
                        fmt(0.5 / rate) + " for a command held over one period");
     }
