@@ -185,7 +185,7 @@ IdentifyOptions library_options(const IdentifyCliOptions& o) {
   if (o.model == "integral") {
     out.model = IdentificationModel::kIntegral;
     if (!(o.interval >= 0.0)) {
-      throw UsageError("--interval " + std::to_string(o.interval) +
+      throw UsageError("--interval " + short_number(o.interval) +
                        " is negative; give the interval length in seconds, e.g. 0.01");
     }
     out.integral.interval = o.interval;

@@ -145,7 +145,7 @@ ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& option
       choices.emplace_back("cutoff", c.reason);
       choices.emplace_back("cutoff_hz", fmt(cutoff));
     } else {
-      choices.emplace_back("cutoff", fmt(cutoff) + " Hz (given)");
+      choices.emplace_back("cutoff", fmt(cutoff) + " Hz (" + options.cutoff_source + ")");
       choices.emplace_back("cutoff_hz", fmt(cutoff));
     }
     LowpassOptions lp;
@@ -328,7 +328,8 @@ Eigen::VectorXd zero_velocity_threshold(const ParameterLayout& layout, const Sig
       << "] (the sign of dq is unknown there)); Coulomb columns: the filtered expected sign, "
          "which keeps Fv and Fc unbiased when the cut-off smears the Coulomb step";
   } else {
-    s << "rows with |dq_j| < [" << threshold.transpose() << "] " << verb << " (given)";
+    s << "rows with |dq_j| < [" << threshold.transpose() << "] " << verb << " ("
+      << signal.zero_velocity_source << ")";
   }
   choices.emplace_back("zero_velocity", s.str());
   return threshold;

@@ -74,9 +74,11 @@ StoredIdentifyOptions options_of_stored_result(const IdentifiedResultFile& ident
       o.signal.cutoff_hz = *overrides.cutoff;
     } else if (identified.cutoff_hz > 0.0) {
       o.signal.cutoff_hz = identified.cutoff_hz;
+      o.signal.cutoff_source = "as identify used it";
       out.notes.push_back("cut-off as identify used it (stored in '" + path + "')");
     } else {
       o.signal.cutoff_hz = file.get("cutoff_hz", 0.0);
+      o.signal.cutoff_source = "as given to identify";
     }
     o.signal.savitzky_golay = file.get("savitzky_golay", false);
     // time_shift_s since issue 26 item 7; older results have only torque_offset_s.
@@ -94,12 +96,14 @@ StoredIdentifyOptions options_of_stored_result(const IdentifiedResultFile& ident
       o.signal.zero_velocity = overrides.zero_velocity;
     } else if (static_cast<int>(identified.zero_velocity_threshold.size()) == dof) {
       o.signal.zero_velocity = identified.zero_velocity_threshold;
+      o.signal.zero_velocity_source = "as identify used them";
       if (*std::max_element(o.signal.zero_velocity.begin(), o.signal.zero_velocity.end()) > 0.0) {
         out.notes.push_back("zero-velocity thresholds as identify used them (stored in '" + path +
                             "')");
       }
     } else {
       o.signal.zero_velocity = file.get("zero_velocity", std::vector<double>{});
+      o.signal.zero_velocity_source = "as given to identify";
     }
     // How identify read its run: a log of the same recorder is read the same way (a different
     // rename silently compares other columns).

@@ -302,4 +302,33 @@ TEST_F(RunFlagsCli, ValidateJsonNamesTheMovingRowsFigure) {
   EXPECT_NE(v.out.find(headline), std::string::npos) << v.out;
 }
 
+// Item 6: excite names the flags that fix missing limits, not the library's fields.
+TEST_F(RunFlagsCli, ExciteNamesTheFlagsThatBoundTheExcitation) {
+  // planar2 has no joint limits in its model.
+  const CliRun r = run("excite --robot planar2 --out " + path("traj.csv"));
+  expect_error(r, 2, {"--velocity-limit", "--acceleration-limit", "shoulder"});
+  EXPECT_EQ(r.err.find("q_min"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("dq_max"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("traj.csv")));
+}
+
+// Item 6: "(given)" only for values the user gave: validate's stored cut-off and thresholds
+// say where they come from.
+TEST_F(RunFlagsCli, GivenOnlyForValuesTheUserGave) {
+  const std::string data = write_standard_run("run.csv");
+  const std::string result = path("result.json");
+  const CliRun id = run("identify --robot planar2 --data " + data +
+                        " --cutoff 4 --zero-velocity 0.05 --out " + result);
+  ASSERT_EQ(id.code, 0) << id.err;
+  EXPECT_NE(id.err.find("4 Hz (given)"), std::string::npos) << id.err;
+  const CliRun v = run("validate --robot planar2 --params " + result + " --data " + data);
+  ASSERT_EQ(v.code, 0) << v.err;
+  EXPECT_EQ(v.err.find("(given)"), std::string::npos) << v.err;
+  EXPECT_NE(v.err.find("4 Hz (as identify used it)"), std::string::npos) << v.err;
+  const CliRun w =
+      run("validate --robot planar2 --params " + result + " --data " + data + " --cutoff 5");
+  ASSERT_EQ(w.code, 0) << w.err;
+  EXPECT_NE(w.err.find("5 Hz (given)"), std::string::npos) << w.err;
+}
+
 }  // namespace
