@@ -141,7 +141,7 @@ IdentifyOptions identify_options(const py::kwargs& kw, nlohmann::json& used,
                                  bool* physical = nullptr) {
   static const char* const kKeys[] = {"armature",   "viscous",   "coulomb",    "offset",
                                       "asymmetric", "estimator", "confidence", "cutoff_hz",
-                                      "filter",     "decimate",  "physical"};
+                                      "filter",     "decimate",  "physical",   "time_shift"};
   check_keywords(kw, kKeys);
   if (!physical && kw.contains("physical")) {
     throw py::type_error("physical is an option of identify(), not of validate()");
@@ -161,6 +161,10 @@ IdentifyOptions identify_options(const py::kwargs& kw, nlohmann::json& used,
   o.signal.cutoff_hz = get("cutoff_hz", 0.0);
   o.signal.filter = get("filter", true);
   o.signal.decimate = get("decimate", 0);
+  // identify's --time-shift, stored under the command line's key so that `dynid validate` and
+  // validate() of a stored result shift alike.
+  o.signal.torque_time_offset = kw.contains("time_shift") ? kw["time_shift"].cast<double>() : 0.0;
+  used["time_shift_s"] = o.signal.torque_time_offset;
   if (physical) *physical = get("physical", false);
   return o;
 }
@@ -314,7 +318,7 @@ nlohmann::json payload(const Model& model, const std::string& sensor_link,
     SignalOptions signal;
     signal.filter = get("filter", true);
     signal.cutoff_hz = get("cutoff_hz", 0.0);
-    PreparedLoadRun run = prepare_load_run(record, w, signal, choices);
+    PreparedLoadRun run = prepare_sensor_run(model, mount, record, w, signal, k.equations, choices);
     // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
     k.options.hac_covariance = signal.filter;
     w = std::move(run.wrench);
@@ -661,7 +665,8 @@ PYBIND11_MODULE(dynid, m) {
       "(m,) [s], q and tau (m x n), optional dq, ddq (derived from q when absent). Options: "
       "armature, viscous, coulomb, offset, asymmetric (bool: the per-joint columns), estimator "
       "('ols', 'wls', 'rls'), confidence (0.999), cutoff_hz (0 = automatic), filter (bool), "
-      "decimate (0 = automatic), physical (bool, --physical: also physically consistent standard "
+      "decimate (0 = automatic), time_shift (s, --time-shift: the torque sampled at t acts at "
+      "t + time_shift), physical (bool, --physical: also physically consistent standard "
       "parameters, log-Cholesky fit of C. Rucker, P. M. Wensing, 2022, for export_urdf). Returns "
       "a dict with the keys of the result JSON (parameters, condition_number, residual_rms, "
       "plot, and with physical standard_parameters, physically_consistent, physical).");

@@ -15,9 +15,11 @@
 #include "dynid/identification/option_text.hpp"
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/io/csv_writer.hpp"
+#include "dynid/io/joint_record_file.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/signal/period_averaging.hpp"
 #include "dynid/signal/periodic_filter.hpp"
+#include "run_flags.hpp"
 
 namespace dynid::cli {
 namespace {
@@ -29,9 +31,10 @@ struct AverageCliOptions {
   std::string filter = "none";  // --filter
   double cutoff = 0.0;          // --cutoff [Hz]
   int decimate = 1;             // --decimate
+  RunFlags run;                 // --rate, --columns, --torque-scale, --rows, --time, ...
 };
 
-void run(const AverageCliOptions& o) {
+void run(const AverageCliOptions& o, const CLI::App& cmd) {
   if ((o.period > 0.0) == (o.f0 > 0.0))
     throw UsageError("give exactly one of --period S or --f0 HZ (> 0)");
   if (o.skip_periods < 0) throw UsageError("--skip-periods must be >= 0");
@@ -51,26 +54,34 @@ void run(const AverageCliOptions& o) {
   if (!filtered && o.decimate > 1)
     throw UsageError("--decimate " + std::to_string(o.decimate) +
                      " needs a low-pass against aliasing: give --filter and --cutoff too");
-  const CsvTable table = read_csv(o.data);
-  Eigen::Index t_col = -1;
+  if (run_flag_given(cmd, "--time-shift")) {
+    std::cerr << "warning: --time-shift has no effect on dynid average (the columns are averaged "
+                 "as logged); give it to identify, which reads the averaged period\n";
+  }
+  RunFileReport read;
+  const RunFileOptions file = run_file_options(o.run);
+  RunTable run = read_run_table(o.data, file, read);
+  scale_torque_columns(run, file, read);
+  for (const auto& w : read.warnings) std::cerr << "warning: " << one_line(w) << '\n';
+  // The first note says the file was read; the others what a run flag did to it.
+  for (std::size_t i = 1; i < read.notes.size(); ++i)
+    std::cerr << "average: " << one_line(read.notes[i]) << '\n';
+  const CsvTable& table = run.table;
   std::vector<std::string> names;
   std::vector<Eigen::Index> cols;
   for (Eigen::Index c = 0; c < static_cast<Eigen::Index>(table.columns.size()); ++c) {
-    if (table.columns[c] == "t") {
-      t_col = c;
-    } else {
+    if (table.columns[c] != "t") {
       names.push_back(table.columns[c]);
       cols.push_back(c);
     }
   }
-  if (t_col < 0) throw Error(o.data + " has no t column: period averaging needs the sample times");
   if (cols.empty()) throw Error(o.data + " has no column besides t: nothing to average");
   Eigen::MatrixXd x(table.data.rows(), static_cast<Eigen::Index>(cols.size()));
   for (Eigen::Index j = 0; j < x.cols(); ++j) x.col(j) = table.data.col(cols[j]);
   TimedPeriodAverageOptions options;
   options.start = o.start;
   options.skip_periods = o.skip_periods;
-  const TimedPeriodAverage a = average_periods_in_time(table.data.col(t_col), x, period, options);
+  const TimedPeriodAverage a = average_periods_in_time(run.t, x, period, options);
   const std::vector<std::string> warnings = check_period_repeats(a, x, names);
 
   // Seed 2 section 3.4: averaged, then low-passed (8th-order Chebyshev at 80 Hz) and resampled
@@ -204,7 +215,8 @@ void add_average_command(CLI::App& app) {
                   "Keep every N-th sample of the filtered period (must divide its samples; the "
                   "cut-off must be below the new Nyquist rate), e.g. 5 for 1 kHz to 200 Hz")
       ->capture_default_str();
-  cmd->callback([o] { run(*o); });
+  add_run_flags(cmd, o->run);
+  cmd->callback([o, cmd] { run(*o, *cmd); });
 }
 
 }  // namespace dynid::cli

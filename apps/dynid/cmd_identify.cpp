@@ -37,28 +37,27 @@
 #include "dynid/sim/pid_gains.hpp"
 #include "dynid/sim/simulate_reference.hpp"
 #include "flag_checks.hpp"
+#include "run_flags.hpp"
 
 namespace dynid::cli {
 namespace {
 
 struct IdentifyCliOptions {
-  std::string robot, data, out, columns;
+  std::string robot, data, out;
+  RunFlags run;                   // --rate, --columns, --torque-scale, --rows, --time, ...
   std::vector<std::string> runs;  // --data, repeatable (identify)
   std::string history;            // --history (identify, rls)
   std::string friction = "viscous,coulomb,offset";
   bool no_armature = false;
   std::string filter = "auto";
-  double cutoff = 0.0, rate = 0.0, confidence = 0.999;
+  double cutoff = 0.0, confidence = 0.999;
   int decimate = 0, trim = -1;
   std::string estimator = "ols";
   std::vector<double> zero_velocity;
   bool savgol = false;
   bool stream = false;
   int threads = 0;
-  double torque_offset = 0.0;
   bool filter_coulomb = false;
-  std::vector<double> torque_scale;
-  std::string rows, time;
   std::string outliers = "report";
   std::string model = "differential";  // --model
   double interval = 0.01;              // --interval (integral model)
@@ -102,25 +101,6 @@ void require_output_folder(const std::string& path, const char* flag) {
     throw Error(std::string(flag) + " '" + path + "': folder '" + parent.string() +
                 "' does not exist; create it or write elsewhere");
   }
-}
-
-// How to read the run: --columns, --rate, --torque-scale, --rows / --time.
-RunFileOptions run_file_options(const std::string& columns, double rate,
-                                const std::vector<double>& torque_scale, const std::string& rows,
-                                const std::string& time) {
-  if (!rows.empty() && !time.empty()) {
-    throw UsageError("give --rows or --time, not both: they both choose the window of the run");
-  }
-  if (!(rate >= 0.0) || !std::isfinite(rate)) {
-    throw UsageError("--rate must be a positive sample rate in Hz");
-  }
-  RunFileOptions file;
-  file.columns = parse_column_mapping(columns);
-  file.rate_hz = rate;
-  file.torque_scale = torque_scale;
-  if (!rows.empty()) file.window = parse_run_window(rows, false, "--rows");
-  if (!time.empty()) file.window = parse_run_window(time, true, "--time");
-  return file;
 }
 
 // One line per processing choice on stderr (the result JSON keeps them under `choices`).
@@ -177,7 +157,7 @@ IdentifyOptions library_options(const IdentifyCliOptions& o) {
   out.signal.trim = o.trim;
   out.signal.zero_velocity = o.zero_velocity;
   out.signal.savitzky_golay = o.savgol;
-  out.signal.torque_time_offset = o.torque_offset;
+  out.signal.torque_time_offset = o.run.shift();
   out.signal.filter_coulomb_columns = o.filter_coulomb;
   if (o.outliers != "report" && o.outliers != "drop") {
     throw UsageError("--outliers must be report or drop, not '" + o.outliers + "'");
@@ -207,7 +187,7 @@ IdentifyOptions library_options(const IdentifyCliOptions& o) {
   if (o.model == "integral") {
     out.model = IdentificationModel::kIntegral;
     if (!(o.interval >= 0.0)) {
-      throw UsageError("--interval " + std::to_string(o.interval) +
+      throw UsageError("--interval " + short_number(o.interval) +
                        " is negative; give the interval length in seconds, e.g. 0.01");
     }
     out.integral.interval = o.interval;
@@ -225,19 +205,21 @@ nlohmann::json echo(const IdentifyCliOptions& o) {
           {"cutoff_hz", o.cutoff},
           {"decimate", o.decimate},
           {"trim", o.trim},
-          {"rate_hz", o.rate},
+          {"rate_hz", o.run.rate},
           {"estimator", o.estimator},
           {"confidence_level", o.confidence},
           {"zero_velocity", o.zero_velocity},
           {"savitzky_golay", o.savgol},
-          {"torque_offset_s", o.torque_offset},
+          {"torque_offset_s", o.run.shift()},  // the old name of time_shift_s
+          {"time_shift_s", o.run.shift()},
           {"filter_coulomb_columns", o.filter_coulomb},
           {"outliers", o.outliers},
           {"model", o.model},
-          {"columns", o.columns},
-          {"torque_scale", o.torque_scale},
-          {"rows", o.rows},
-          {"time", o.time},
+          {"columns", o.run.columns},
+          {"torque_scale", o.run.torque_scale},
+          {"torque_bias", o.run.torque_bias},
+          {"rows", o.run.rows},
+          {"time", o.run.time},
           {"friction_known", o.friction_known},
           {"closed_loop", o.closed_loop},
           {"fir", o.fir},
@@ -246,23 +228,6 @@ nlohmann::json echo(const IdentifyCliOptions& o) {
           {"noise", o.noise},
           {"noise_std", o.noise_std},
           {"repeat", o.repeat}};
-}
-
-// The flags that say how to read a run (identify, validate).
-void add_run_flags(CLI::App* cmd, double& rate, std::string& columns,
-                   std::vector<double>& torque_scale, std::string& rows, std::string& time) {
-  cmd->add_option("--rate", rate, "Sample rate [Hz] when the file has no t column");
-  cmd->add_option("--columns", columns,
-                  "Rename columns before lookup: from=to,from2=to2; for a file without a header, "
-                  "name columns by position counted from 1: 1=t,2=q1,3=q2,...");
-  cmd->add_option("--torque-scale", torque_scale,
-                  "tau_j = K_j * logged torque column (e.g. drive gain x current): one value or "
-                  "one per joint, comma separated")
-      ->delimiter(',');
-  cmd->add_option("--rows", rows,
-                  "Use data rows A:B only (counted from 1 after the header, inclusive; A: or :B "
-                  "leave an end open)");
-  cmd->add_option("--time", time, "Use the samples with T0 <= t <= T1 [s] only (T0: or :T1 open)");
 }
 
 void add_signal_flags(CLI::App* cmd, IdentifyCliOptions& o) {
@@ -281,16 +246,13 @@ void add_signal_flags(CLI::App* cmd, IdentifyCliOptions& o) {
                   "Keep every N-th sample after filtering; 0 = rate/(10·cut-off)");
   cmd->add_option("--trim", o.trim,
                   "Samples dropped at each end after filtering; -1 = 3·rate/cut-off");
-  add_run_flags(cmd, o.rate, o.columns, o.torque_scale, o.rows, o.time);
+  add_run_flags(cmd, o.run);
   cmd->add_flag("--savgol", o.savgol,
                 "Differentiate with Savitzky-Golay instead of central differences");
   cmd->add_option("--friction", o.friction,
                   "Friction terms: comma list of viscous, coulomb, offset; or asymmetric; or none")
       ->capture_default_str();
   cmd->add_flag("--no-armature", o.no_armature, "Do not identify the actuator inertias Ia");
-  cmd->add_option("--torque-offset", o.torque_offset,
-                  "The torque logged at t acts at t + S [s]: half the sample period for a "
-                  "command held over the next step (dynid simulate), -d for a sensor lagging d");
   cmd->add_flag("--filter-coulomb", o.filter_coulomb,
                 "Filter the sign(dq) columns like tau (parallel filtering): unbiased Fv and Fc "
                 "when the filter smears the Coulomb step at reversals");
@@ -450,8 +412,8 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     o.friction = "none";  // only the rigid body (and armature) is estimated (seed 2 §3.4)
     for (const auto& f : o.friction_known) require_readable(f, "--friction-known");
   }
+  const RunFileOptions file = run_file_options(o.run);  // first: it checks the time shift
   IdentifyOptions options = library_options(o);
-  const RunFileOptions file = run_file_options(o.columns, o.rate, o.torque_scale, o.rows, o.time);
   if (!o.history.empty() && options.estimator != IdentificationEstimator::kRls) {
     throw UsageError("--history needs --estimator rls (the batch estimators have no history)");
   }
@@ -466,11 +428,11 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   require_output_folder(o.out, "--out");
   require_output_folder(o.history, "--history");
   require_output_folder(o.report, "--report");
-  if (o.stream &&
-      (!o.torque_scale.empty() || !file.window.empty() || columns_by_position(file.columns))) {
+  if (o.stream && (!o.run.torque_scale.empty() || !file.torque_bias.empty() ||
+                   !file.window.empty() || columns_by_position(file.columns))) {
     throw UsageError(
-        "--stream reads named columns as they are; --torque-scale, --rows, --time and "
-        "--columns by position need the in-memory mode (drop --stream)");
+        "--stream reads named columns as they are; --torque-scale, --torque-bias, --rows, --time "
+        "and --columns by position need the in-memory mode (drop --stream)");
   }
   if (options.estimator != IdentificationEstimator::kMl &&
       (!o.noise.empty() || !o.noise_std.empty()))
@@ -608,14 +570,12 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
 }
 
 struct ValidateCliOptions {
-  std::string robot, params, data, json, columns, mode = "torque", trajectory, engine = "mujoco";
+  std::string robot, params, data, json, mode = "torque", trajectory, engine = "mujoco";
+  RunFlags run;  // --rate, --columns, --torque-scale, ...: default the ones stored in --params
   std::string predicted;
   std::string controller, gains, histograms;  // --mode simulation: the run's loop, error PDFs
   std::string report;                         // --report
-  double rate = 0.0;
   std::vector<double> zero_velocity;
-  std::vector<double> torque_scale;
-  std::string rows, time;
   double cutoff = 0.0;
 };
 
@@ -630,7 +590,7 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
   if (v.engine != "mujoco" && v.engine != "native") {
     throw UsageError("--engine must be mujoco or native, not '" + v.engine + "'");
   }
-  RunFileOptions file = run_file_options(v.columns, v.rate, v.torque_scale, v.rows, v.time);
+  RunFileOptions file = run_file_options(v.run);
   require_readable(v.params, "--params");
   require_readable(v.data, "--data");
   require_output_folder(v.json, "--json");
@@ -659,14 +619,28 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
   StoredOptionOverrides overrides;
   if (cmd.count("--cutoff")) overrides.cutoff = v.cutoff;
   overrides.zero_velocity = v.zero_velocity;
-  overrides.torque_scale_given = !v.torque_scale.empty() || cmd.count("--torque-scale");
+  overrides.torque_scale_given = run_flag_given(cmd, "--torque-scale");
+  overrides.columns_given = run_flag_given(cmd, "--columns");
+  overrides.rate_given = run_flag_given(cmd, "--rate");
+  overrides.torque_bias_given = run_flag_given(cmd, "--torque-bias");
+  if (run_flag_given(cmd, "--time-shift")) overrides.time_shift = v.run.shift();
   const StoredIdentifyOptions stored =
       options_of_stored_result(identified, v.params, model.dof(), overrides);
-  if (!overrides.torque_scale_given) file.torque_scale = stored.torque_scale;
+  stored.apply_to(file);
   read.notes.insert(read.notes.end(), stored.notes.begin(), stored.notes.end());
   IdentifyOptions options = stored.options;
   add_stored_known_friction(identified, v.params, model, names, values, options);
-  const JointRecord record = read_joint_record(v.data, model, file, &read);
+  const JointRecord record = [&] {
+    try {
+      return read_joint_record(v.data, model, file, &read);
+    } catch (const Error& e) {
+      // A rename stored by identify may not fit this run: say where it came from and the fix.
+      const std::string text = e.what();
+      if (stored.columns.empty() || text.find("--columns") == std::string::npos) throw;
+      throw Error(text + " (the --columns given to identify, stored in '" + v.params +
+                  "'; give --columns for this run)");
+    }
+  }();
   if (v.mode == "simulation") {
     RunFileOptions reference_file;
     if (!columns_by_position(file.columns)) reference_file.columns = file.columns;
@@ -892,11 +866,7 @@ void add_validate_command(CLI::App& app) {
   cmd->add_option("--predicted", v->predicted,
                   "Write t and, per joint, measured torque, predicted torque, residual and a "
                   "left-out flag as CSV (tau<j>, tau_pred<j>, residual<j>, left_out<j>)");
-  add_run_flags(cmd, v->rate, v->columns, v->torque_scale, v->rows, v->time);
-  cmd->get_option("--torque-scale")
-      ->description(
-          "tau_j = K_j * logged torque column (e.g. drive gain x current): one value or one per "
-          "joint, comma separated; default: the scale given to identify (stored in --params)");
+  add_run_flags(cmd, v->run, RunFlagDefaults::kStoredInParams);
   cmd->add_option("--cutoff", v->cutoff,
                   "Filter cut-off [Hz] for this run; default: the cut-off identify used (stored "
                   "in --params); auto (= 0) chooses again from this run")

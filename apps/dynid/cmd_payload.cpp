@@ -31,12 +31,14 @@
 #include "dynid/report/stored_result.hpp"
 #include "dynid/version.hpp"
 #include "flag_checks.hpp"
+#include "run_flags.hpp"
 
 namespace dynid::cli {
 namespace {
 
 struct PayloadCliOptions {
-  std::string data, robot, sensor_link, sensor_pose, out, history, columns;
+  std::string data, robot, sensor_link, sensor_pose, out, history;
+  RunFlags run;                        // --rate, --columns, --torque-scale, --rows, --time, ...
   std::string link, reference, frame;  // joint-torque mode
   std::string report;                  // --report: HTML page of the result
   std::string model = "differential";
@@ -126,24 +128,32 @@ void write_torque_result(const PayloadCliOptions& cli, const LoadIdentificationR
 // `--link LINK --reference result.json`: the load from the torque that the identified model of
 // the unloaded robot does not explain. The loaded run is processed and predicted exactly as
 // `dynid validate` does with that result (same options, cut-off and zero-velocity thresholds).
-void run_payload_from_result(const PayloadCliOptions& cli, LoadIdentificationOptions options,
-                             const Model& model, int link, const LoadFrame& frame,
-                             RunFileOptions file) {
+void run_payload_from_result(const PayloadCliOptions& cli, const CLI::App& cmd,
+                             LoadIdentificationOptions options, const Model& model, int link,
+                             const LoadFrame& frame, RunFileOptions file) {
   const IdentifiedResultFile identified = read_identification_result(cli.reference);
   require_same_robot(identified.robot, model.name, "--reference '" + cli.reference + "'",
                      "give a result of the robot that carries the load");
   RunFileReport read;
+  // The loaded run is read as identify read the unloaded one, unless a run flag says otherwise.
+  StoredOptionOverrides overrides;
+  overrides.torque_scale_given = run_flag_given(cmd, "--torque-scale");
+  overrides.columns_given = run_flag_given(cmd, "--columns");
+  overrides.rate_given = run_flag_given(cmd, "--rate");
+  overrides.torque_bias_given = run_flag_given(cmd, "--torque-bias");
+  if (run_flag_given(cmd, "--time-shift")) overrides.time_shift = cli.run.shift();
   const StoredIdentifyOptions stored =
-      options_of_stored_result(identified, cli.reference, model.dof());
-  file.torque_scale = stored.torque_scale;
+      options_of_stored_result(identified, cli.reference, model.dof(), overrides);
+  stored.apply_to(file);
   read.notes.insert(read.notes.end(), stored.notes.begin(), stored.notes.end());
   const IdentifyOptions& identify = stored.options;
-  for (const auto& note : read.notes) std::cerr << "payload: " << one_line(note) << '\n';
   if (cli.cutoff != 0.0 || cli.no_filter) {
     std::cerr << "warning: --cutoff and --no-filter have no effect with a result.json reference: "
                  "the loaded run is filtered as identify filtered the unloaded one\n";
   }
-  const JointRecord loaded_raw = read_joint_record(cli.data, model, file);
+  const JointRecord loaded_raw = read_joint_record(cli.data, model, file, &read);
+  for (const auto& w : read.warnings) std::cerr << "warning: " << one_line(w) << '\n';
+  for (const auto& note : read.notes) std::cerr << "payload: " << one_line(note) << '\n';
   const ValidationResult predicted = validate_torques(
       model, loaded_raw, identified.names, identified.values, identify, identified.not_excited,
       nominal_completion_of_result(model, identified, cli.reference));
@@ -164,7 +174,8 @@ void run_payload_from_result(const PayloadCliOptions& cli, LoadIdentificationOpt
 }
 
 // `--link LINK --reference unloaded.csv`: robot and load together from joint torques.
-void run_payload_from_torques(const PayloadCliOptions& cli, LoadIdentificationOptions options) {
+void run_payload_from_torques(const PayloadCliOptions& cli, const CLI::App& cmd,
+                              LoadIdentificationOptions options) {
   if (cli.robot.empty())
     throw UsageError("--link needs --robot R: the robot that carries the load");
   if (cli.reference.empty()) {
@@ -185,18 +196,24 @@ void run_payload_from_torques(const PayloadCliOptions& cli, LoadIdentificationOp
     frame.R_LF = roll_pitch_yaw(pose[3], pose[4], pose[5]);
   }
   const int link = find_link(model, cli.link);
-  RunFileOptions file;
-  file.columns = parse_column_mapping(cli.columns);
+  const RunFileOptions file = run_file_options(cli.run);
   const bool json_reference =
       cli.reference.size() >= 5 && cli.reference.substr(cli.reference.size() - 5) == ".json";
-  if (json_reference) return run_payload_from_result(cli, options, model, link, frame, file);
-  const JointRecord loaded_raw = read_joint_record(cli.data, model, file);
-  const JointRecord unloaded_raw = read_joint_record(cli.reference, model, file);
+  if (json_reference) return run_payload_from_result(cli, cmd, options, model, link, frame, file);
+  // Both runs are read alike; the window (--rows, --time) is of the loaded run only.
+  RunFileReport read;
+  const JointRecord loaded_raw = read_joint_record(cli.data, model, file, &read);
+  RunFileOptions reference_file = file;
+  reference_file.window = {};
+  const JointRecord unloaded_raw = read_joint_record(cli.reference, model, reference_file, &read);
+  for (const auto& w : read.warnings) std::cerr << "warning: " << one_line(w) << '\n';
+  for (const auto& note : read.notes) std::cerr << "payload: " << one_line(note) << '\n';
   // The automatic cut-off of identify (held-out torque prediction) on the unloaded run, for both.
   IdentifyOptions identify;
   identify.layout = ParameterLayout::full();
   identify.signal.filter = !cli.no_filter;
   identify.signal.cutoff_hz = cli.cutoff;
+  identify.signal.torque_time_offset = cli.run.shift();
   const CutoffSelection cutoff = select_cutoff(model, unloaded_raw, identify);
   const SignalOptions signal = cutoff.signal;
   std::vector<std::pair<std::string, std::string>> choices, reference_choices;
@@ -211,7 +228,7 @@ void run_payload_from_torques(const PayloadCliOptions& cli, LoadIdentificationOp
   write_torque_result(cli, r, model, link, choices);
 }
 
-void run_payload(const PayloadCliOptions& cli) {
+void run_payload(const PayloadCliOptions& cli, const CLI::App& cmd) {
   if (cli.out.empty()) throw UsageError("--out is required: the JSON file to write");
   if (const auto folder = std::filesystem::path(cli.report).parent_path();
       !folder.empty() && !std::filesystem::is_directory(folder)) {
@@ -251,7 +268,7 @@ void run_payload(const PayloadCliOptions& cli) {
     throw UsageError("--history needs --estimator rls (the estimate after every wrench sample)");
   }
   options.record_history = !cli.history.empty();
-  if (!cli.link.empty()) return run_payload_from_torques(cli, options);
+  if (!cli.link.empty()) return run_payload_from_torques(cli, cmd, options);
   if (!cli.reference.empty() || !cli.frame.empty()) {
     throw UsageError(
         "--reference and --frame are for a load from joint torques: give --link LINK (the link "
@@ -266,8 +283,19 @@ void run_payload(const PayloadCliOptions& cli) {
         "orientation qx qy qz qw in the data)");
   }
 
-  CsvTable table = read_csv(cli.data);
-  apply_column_mapping(table, parse_column_mapping(cli.columns));
+  for (const char* flag : {"--torque-scale", "--torque-bias", "--time-shift"}) {
+    if (run_flag_given(cmd, flag)) {
+      std::cerr << "warning: " << flag
+                << " has no effect on a wrist-sensor run (it is for joint torques, with --link); "
+                   "the sensor's own offsets are --bias\n";
+    }
+  }
+  RunFileReport read;
+  const RunFileOptions file = run_file_options(cli.run);
+  RunTable run = read_run_table(cli.data, file, read, false);
+  for (const auto& w : read.warnings) std::cerr << "warning: " << one_line(w) << '\n';
+  for (const auto& note : read.notes) std::cerr << "payload: " << one_line(note) << '\n';
+  const CsvTable& table = run.table;
   const std::vector<std::string> wrench_names = {"fx", "fy", "fz", "mx", "my", "mz"};
   std::string missing;
   for (const auto& name : wrench_names) {
@@ -279,15 +307,12 @@ void run_payload(const PayloadCliOptions& cli) {
   }
   Eigen::MatrixXd wrench(table.rows(), 6);
   for (int c = 0; c < 6; ++c) wrench.col(c) = table.data.col(table.index(wrench_names[c]));
-  const auto t_column = equations.model == LoadModelKind::kStatic ? std::optional<Eigen::Index>()
-                                                                  : checked_time_column(table);
-  if (equations.model != LoadModelKind::kStatic && !t_column) {
+  if (equations.model != LoadModelKind::kStatic && run.t.size() == 0) {
     throw Error("--data '" + cli.data +
-                "' has no t column; a moving load needs time stamps (or give --static for "
-                "standing poses)");
+                "' has no t column; a moving load needs time stamps: add t, give the sample "
+                "rate with --rate HZ, or give --static for standing poses");
   }
-  const Eigen::VectorXd t =
-      t_column ? Eigen::VectorXd(table.data.col(*t_column)) : Eigen::VectorXd();
+  const Eigen::VectorXd t = equations.model == LoadModelKind::kStatic ? Eigen::VectorXd() : run.t;
 
   std::vector<std::pair<std::string, std::string>> choices;
   SensorMotion motion;
@@ -319,10 +344,8 @@ void run_payload(const PayloadCliOptions& cli) {
       signal.filter = !cli.no_filter;
       signal.cutoff_hz = cli.cutoff;
       // The automatic cut-off by held-out prediction of the wrench, as identify chooses its own.
-      const CutoffSelection cutoff =
-          select_load_cutoff(model, mount, record, wrench, signal, equations);
-      PreparedLoadRun run = prepare_load_run(record, wrench, cutoff.signal, choices);
-      echo_cutoff_selection(cutoff, choices);
+      PreparedLoadRun run =
+          prepare_sensor_run(model, mount, record, wrench, signal, equations, choices);
       // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
       options.hac_covariance = signal.filter;
       wrench = std::move(run.wrench);
@@ -415,7 +438,7 @@ void add_payload_command(CLI::App& app) {
   cmd->add_option("--cutoff", o->cutoff,
                   "With --robot: low-pass cut-off [Hz] for q and the wrench; 0 = automatic");
   cmd->add_flag("--no-filter", o->no_filter, "With --robot: do not low-pass q and the wrench");
-  cmd->add_option("--columns", o->columns, "Rename input columns: from=to,from=to");
+  add_run_flags(cmd, o->run);
   cmd->add_option("--link", o->link,
                   "Without a sensor: the link (or joint) that carries the load; --data is then a "
                   "run with the load (t, q*, tau*) and --reference one without it");
@@ -427,7 +450,7 @@ void add_payload_command(CLI::App& app) {
   cmd->add_option("--frame", o->frame,
                   "With --link: \"x y z roll pitch yaw\" of the frame (e.g. the tool flange) in "
                   "the link frame [m, rad] in which the load is reported; default the link frame");
-  cmd->callback([o] { run_payload(*o); });
+  cmd->callback([o, cmd] { run_payload(*o, *cmd); });
 }
 
 }  // namespace dynid::cli

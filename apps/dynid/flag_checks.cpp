@@ -31,6 +31,8 @@ const SignRule kSignRules[] = {
     {"validate", "--cutoff", Sign::kNonNegative},
     {"validate", "--rate", Sign::kNonNegative},
     {"validate", "--zero-velocity", Sign::kNonNegative},
+    {"payload", "--rate", Sign::kNonNegative},
+    {"average", "--rate", Sign::kNonNegative},
     {"excite", "--harmonics", Sign::kPositive},
     {"excite", "--f0", Sign::kPositive},
     {"excite", "--fmax", Sign::kNonNegative},

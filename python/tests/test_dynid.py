@@ -105,6 +105,27 @@ def test_identify_recovers_the_closed_form_arm_within_its_intervals(planar2):
     assert 0.0 < v["relative_error"] < 0.05
 
 
+def test_time_shift_is_stored_and_validate_applies_it(planar2):
+    # identify's --time-shift (issue 26 item 7): stored as the command line stores it, and a
+    # validate() of the stored result shifts the other run alike. Oracle: the closed-form torques
+    # delayed by half a sample and shifted back are the closed-form torques again (to the
+    # interpolation error), so the shifted fit predicts them better than the unshifted one.
+    t, q, dq, ddq = fourier_run(4)
+    dt = t[1] - t[0]
+    tau = planar2_torques(q, dq, ddq)
+    delayed = np.vstack([tau[:1], 0.5 * (tau[1:] + tau[:-1])])  # tau(t - dt/2), linear
+    options = dict(armature=False, viscous=False, coulomb=False, offset=False, filter=False)
+    shifted = dynid.identify(planar2, t, q, delayed, dq=dq, ddq=ddq, time_shift=-dt / 2, **options)
+    plain = dynid.identify(planar2, t, q, delayed, dq=dq, ddq=ddq, **options)
+    assert shifted["options"]["time_shift_s"] == pytest.approx(-dt / 2)
+    assert plain["options"]["time_shift_s"] == 0.0
+    assert shifted["relative_error"] < 0.5 * plain["relative_error"]
+    v = dynid.validate(planar2, shifted, t, q, delayed, dq=dq, ddq=ddq)
+    assert v["relative_error_moving"] == v["relative_error"]
+    assert v["relative_error_all_rows"] < 0.5 * dynid.validate(
+        planar2, plain, t, q, delayed, dq=dq, ddq=ddq)["relative_error_all_rows"]
+
+
 def test_bad_input_raises_with_a_message(planar2):
     z = np.zeros((5, 3))
     with pytest.raises(dynid.Error, match="q must be 5 x 2"):

@@ -392,7 +392,7 @@ ClosedLoopRun prepare_closed_loop(const JointRecord& input, const ReferenceRecor
   if (options.torque_time_offset != 0.0) {
     if (!std::isfinite(options.torque_time_offset) ||
         std::abs(options.torque_time_offset) > 100.0 * ts)
-      throw UsageError("--torque-offset " + num(options.torque_time_offset) +
+      throw UsageError("--time-shift " + num(options.torque_time_offset) +
                        " s is not a small finite time (at most 100 samples)");
     const Eigen::Index m = run.t.size();
     const Eigen::VectorXd shifted = run.t.array() + options.torque_time_offset;

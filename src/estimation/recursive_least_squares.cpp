@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/estimation/statistics.hpp"
 #include "factor_solve.hpp"
 #include "ud_update.hpp"
@@ -127,8 +128,8 @@ Estimate RecursiveLeastSquares::estimate(const EstimationOptions& options) const
   e.covariance = e.residual_variance * P;
   fill_parameter_statistics(e, options);
   if (e.summary.condition_number > options.condition_warning) {
-    e.summary.warnings.push_back("condition number " + std::to_string(e.summary.condition_number) +
-                                 " exceeds " + std::to_string(options.condition_warning) +
+    e.summary.warnings.push_back("condition number " + short_number(e.summary.condition_number) +
+                                 " exceeds " + short_number(options.condition_warning) +
                                  ": the data excite some parameters poorly");
   }
   if (!e.poorly_excited.empty()) {

@@ -4,15 +4,14 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <iomanip>
 #include <limits>
-#include <sstream>
 #include <string>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/estimation/statistics.hpp"
 #include "factor_solve.hpp"
 #include "gram_update.hpp"
@@ -41,12 +40,6 @@ struct ScaledGram {
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig;
   bool positive = false;  // every column non-zero
 };
-
-std::string short_number(double v) {
-  std::ostringstream out;
-  out << std::setprecision(3) << v;
-  return out.str();
-}
 
 ScaledGram scaled_gram(const Eigen::MatrixXd& upper) {
   ScaledGram s;
@@ -472,12 +465,14 @@ Estimate StreamingLeastSquares::solve(const Eigen::VectorXd& weights, EstimatorK
     e.summary.warnings.push_back(
         "W is rank deficient (rank " + std::to_string(s.rank) + " < " + std::to_string(p) +
         "): parameters " + column_list(options, s.unidentifiable) +
-        " are not identifiable individually; regroup them into base parameters or drop " +
-        column_list(options, s.dependent_columns));
+        " are not identifiable individually; " +
+        (options.rank_deficient_remedy.empty() ? "regroup them into base parameters or drop " +
+                                                     column_list(options, s.dependent_columns)
+                                               : options.rank_deficient_remedy));
   }
   if (s.condition_number > options.condition_warning) {
-    e.summary.warnings.push_back("condition number " + std::to_string(s.condition_number) +
-                                 " exceeds " + std::to_string(options.condition_warning) +
+    e.summary.warnings.push_back("condition number " + short_number(s.condition_number) +
+                                 " exceeds " + short_number(options.condition_warning) +
                                  ": the data excite some parameters poorly");
     if (s.rank == p) {
       // Parameters dominating the weakest singular direction.

@@ -141,9 +141,10 @@ Problem resolve(const Model& model, const ExcitationOptions& o, double base_seco
       const double wk = p.w * k;
       const double bnd = std::min({p.dq_max[j], p.ddq_max[j] / wk, wk * 0.5 * range});
       if (!std::isfinite(bnd))
-        throw Error("excitation limits of joint " + std::to_string(j + 1) +
-                    ": no finite position, velocity or acceleration limit bounds the "
-                    "coefficients; set q_min/q_max, dq_max or ddq_max");
+        throw Error("joint " + std::to_string(j + 1) + " (" + model.joints[j].name +
+                    ") has no finite position, velocity or acceleration limit to bound its "
+                    "excitation: give --velocity-limit or --acceleration-limit, "
+                    "or position limits in the robot model");
       bound[static_cast<size_t>(k - 1)] = bnd;
     }
     for (int rep = 0; rep < 2; ++rep)

@@ -161,7 +161,7 @@ ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& option
   if (options.torque_time_offset != 0.0) {
     if (!std::isfinite(options.torque_time_offset) ||
         std::abs(options.torque_time_offset) * rate > 100.0) {
-      throw UsageError("--torque-offset " + fmt(options.torque_time_offset) +
+      throw UsageError("--time-shift " + fmt(options.torque_time_offset) +
                        " s is not a small finite time (at most 100 samples); give e.g. " +
                        fmt(0.5 / rate) + " for a command held over one period");
     }
@@ -188,7 +188,7 @@ ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& option
       choices.emplace_back("cutoff", c.reason);
       choices.emplace_back("cutoff_hz", fmt(cutoff));
     } else {
-      choices.emplace_back("cutoff", fmt(cutoff) + " Hz (given)");
+      choices.emplace_back("cutoff", fmt(cutoff) + " Hz (" + options.cutoff_source + ")");
       choices.emplace_back("cutoff_hz", fmt(cutoff));
     }
     LowpassOptions lp;
@@ -371,7 +371,8 @@ Eigen::VectorXd zero_velocity_threshold(const ParameterLayout& layout, const Sig
       << "] (the sign of dq is unknown there)); Coulomb columns: the filtered expected sign, "
          "which keeps Fv and Fc unbiased when the cut-off smears the Coulomb step";
   } else {
-    s << "rows with |dq_j| < [" << threshold.transpose() << "] " << verb << " (given)";
+    s << "rows with |dq_j| < [" << threshold.transpose() << "] " << verb << " ("
+      << signal.zero_velocity_source << ")";
   }
   choices.emplace_back("zero_velocity", s.str());
   return threshold;

@@ -272,7 +272,7 @@ void reject_unsupported_signal_options(const SignalOptions& s) {
     reject("--savgol", "the stream uses the dq and ddq columns as given");
   }
   if (s.torque_time_offset != defaults.torque_time_offset) {
-    reject("--torque-offset", "re-interpolating the torques needs the whole record");
+    reject("--time-shift", "re-interpolating the torques needs the whole record");
   }
   if (s.filter_coulomb_columns != defaults.filter_coulomb_columns) {
     reject("--filter-coulomb", "the stream is not filtered");

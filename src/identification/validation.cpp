@@ -7,6 +7,7 @@
 #include "dynid/common/error.hpp"
 #include "dynid/identification/pipeline.hpp"
 #include "dynid/model/transmission.hpp"
+#include "dynid/signal/plausibility.hpp"
 #include "identification/preparation.hpp"
 
 namespace dynid {
@@ -23,6 +24,11 @@ ValidationResult validate_torques(const Model& model, const JointRecord& record,
                 std::to_string(nominal.values.size()) + " values");
   }
   ValidationResult out;
+  // The time-units diagnosis identify makes (screen_run): a t column in milliseconds is named as
+  // such here too, before the filter's cut-off search fails on it for another reason.
+  if (record.t.allFinite()) {
+    if (auto warning = check_sample_rate(record.t)) out.choices.emplace_back("warning", *warning);
+  }
   out.processed = preprocess_run(model, record, options.signal, out.choices);
   // As identify() does: a joint held by its controller did not move (its jitter is noise).
   hold_still_joints(model, out.processed, out.choices);

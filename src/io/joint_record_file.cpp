@@ -5,6 +5,7 @@
 #include <cstdlib>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/model/transmission.hpp"
 #include "dynid/signal/differentiation.hpp"
@@ -130,48 +131,171 @@ bool columns_by_position(const ColumnMapping& mapping) {
   return positions != 0;
 }
 
-JointRecord read_joint_record(const std::string& path, const Model& model,
-                              const RunFileOptions& options, RunFileReport* report) {
-  const int n = model.dof();
-  const Eigen::VectorXd scale = torque_scale(options.torque_scale, n);
-  const bool positional = columns_by_position(options.columns);
-  CsvTable table = positional ? read_csv_without_header(path) : read_csv(path);
-  apply_column_mapping(table, options.columns);
-  RunFileReport local;
-  RunFileReport& out = report ? *report : local;
-  out.notes.push_back("read " + std::to_string(table.rows()) + " rows of '" + path + "'" +
-                      (positional ? " (no header: columns by position, counted from 1)" : ""));
+std::vector<std::pair<std::string, double>> parse_torque_bias(const std::string& text) {
+  std::vector<std::pair<std::string, double>> entries;
+  const std::string usage =
+      "; give J=VALUE per joint, J a joint number from 1 or a joint name, VALUE in N m, e.g. "
+      "--torque-bias 1=0.3,3=-0.12";
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const auto comma = text.find(',', start);
+    std::string item =
+        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    start = comma == std::string::npos ? text.size() + 1 : comma + 1;
+    const auto first = item.find_first_not_of(" \t");
+    if (first == std::string::npos) continue;
+    item = item.substr(first, item.find_last_not_of(" \t") - first + 1);
+    const auto eq = item.find('=');
+    const std::string joint = eq == std::string::npos ? "" : item.substr(0, eq);
+    const std::string value = eq == std::string::npos ? "" : item.substr(eq + 1);
+    char* end = nullptr;
+    const double x = std::strtod(value.c_str(), &end);
+    if (joint.empty() || value.empty() || end == value.c_str() ||
+        std::string(end).find_first_not_of(" \t") != std::string::npos || !std::isfinite(x)) {
+      throw UsageError("--torque-bias entry '" + printable(item) + "' is not J=VALUE" + usage);
+    }
+    for (const auto& e : entries) {
+      if (e.first == joint) {
+        throw UsageError("--torque-bias names joint '" + printable(joint) +
+                         "' twice; give each joint one bias");
+      }
+    }
+    entries.emplace_back(joint, x);
+  }
+  return entries;
+}
+
+namespace {
+
+// The bias vector of `entries` for joints named `names` (numbers from 1 always work) of `robot`.
+Eigen::VectorXd bias_of_joints(const std::vector<std::string>& names, const std::string& robot,
+                               const std::vector<std::pair<std::string, double>>& entries) {
+  const int n = static_cast<int>(names.size());
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
+  for (const auto& [joint, value] : entries) {
+    int j = -1;
+    if (joint.find_first_not_of("0123456789") == std::string::npos && joint.size() < 9) {
+      j = std::atoi(joint.c_str()) - 1;
+      if (j < 0 || j >= n) {
+        throw UsageError("--torque-bias joint " + joint + " is not a joint of " + robot +
+                         "; give 1 to " + std::to_string(n) + " or a joint name");
+      }
+    } else {
+      for (int k = 0; k < n; ++k)
+        if (names[static_cast<std::size_t>(k)] == joint) j = k;
+      if (j < 0) {
+        std::string list;
+        for (const std::string& k : names) list += (list.empty() ? "" : ", ") + k;
+        throw UsageError("--torque-bias joint '" + printable(joint) + "' is not a joint of " +
+                         robot + " (" + printable(list) + "); give its number or name");
+      }
+    }
+    b[j] = value;
+  }
+  return b;
+}
+
+}  // namespace
+
+Eigen::VectorXd torque_bias_vector(const Model& model,
+                                   const std::vector<std::pair<std::string, double>>& entries) {
   std::vector<std::string> names;
   for (const Joint& j : model.joints) names.push_back(j.name);
-  auto has = [&](const char* prefix) { return has_joint_columns(table.columns, names, prefix); };
-  Eigen::VectorXd t;
+  return bias_of_joints(names, "'" + model.name + "'", entries);
+}
+
+void scale_torque_columns(RunTable& run, const RunFileOptions& options, RunFileReport& report) {
+  if (options.torque_scale.empty() && options.torque_bias.empty()) return;
+  CsvTable& table = run.table;
+  const char* prefix = table.find("taum1") ? "taum" : "tau";
+  std::vector<Eigen::Index> columns;
+  std::vector<std::string> numbers;
+  for (int j = 1;; ++j) {
+    const auto c = table.find(prefix + std::to_string(j));
+    if (!c) break;
+    columns.push_back(*c);
+    numbers.push_back(std::to_string(j));
+  }
+  const int n = static_cast<int>(columns.size());
+  if (n == 0) {
+    throw UsageError("--torque-scale and --torque-bias act on the columns tau1..taun, which '" +
+                     table.source + "' does not have; rename its torque columns with --columns");
+  }
+  const Eigen::VectorXd k = torque_scale(options.torque_scale, n);
+  const Eigen::VectorXd b =
+      bias_of_joints(numbers,
+                     "'" + table.source + "' (columns " + prefix + "1.." + prefix +
+                         std::to_string(n) + ", no robot names the joints)",
+                     options.torque_bias);
+  for (int j = 0; j < n; ++j) {
+    table.data.col(columns[static_cast<std::size_t>(j)]) =
+        (table.data.col(columns[static_cast<std::size_t>(j)]) * k[j]).array() - b[j];
+  }
+  report.notes.push_back(std::string(prefix) + "_j = K_j * column - b_j (--torque-scale, " +
+                         "--torque-bias) on " + prefix + "1.." + prefix + std::to_string(n));
+}
+
+RunTable read_run_table(const std::string& path, const RunFileOptions& options, RunFileReport& out,
+                        bool need_time) {
+  const bool positional = columns_by_position(options.columns);
+  RunTable run;
+  CsvTable& table = run.table;
+  table = positional ? read_csv_without_header(path) : read_csv(path);
+  apply_column_mapping(table, options.columns);
+  out.notes.push_back("read " + std::to_string(table.rows()) + " rows of '" + path + "'" +
+                      (positional ? " (no header: columns by position, counted from 1)" : ""));
+  Eigen::VectorXd& t = run.t;
   if (const auto tc = checked_time_column(table)) {
     t = table.data.col(*tc);
     if (options.rate_hz > 0.0) {
-      out.warnings.push_back("--rate " + number(options.rate_hz) + " has no effect: '" + path +
-                             "' has a time column t, which is used");
+      (options.rate_given ? out.warnings : out.notes)
+          .push_back((options.rate_given ? "--rate " + number(options.rate_hz)
+                                         : "the stored rate " + number(options.rate_hz) + " Hz") +
+                     " has no effect: '" + path + "' has a time column t, which is used");
     }
   } else if (options.rate_hz > 0.0) {
     t = Eigen::VectorXd::LinSpaced(table.rows(), 0.0, (table.rows() - 1) / options.rate_hz);
-    out.notes.push_back("time from --rate " + number(options.rate_hz) + " Hz (no t column)");
-  } else {
+    out.notes.push_back("time from " +
+                        std::string(options.rate_given ? "--rate " : "the stored rate ") +
+                        number(options.rate_hz) + " Hz (no t column)");
+  } else if (need_time || options.window.by_time) {
     throw UsageError("'" + path +
                      "' has no time column 't'; add one or give the sample rate with --rate HZ");
   }
   if (!options.window.empty()) {
-    const auto [first, last] = window_rows(options.window, t, path);
+    const Eigen::VectorXd rows =
+        t.size() == table.rows()
+            ? t
+            : Eigen::VectorXd::LinSpaced(table.rows(), 1.0, double(table.rows()));
+    const auto [first, last] = window_rows(options.window, rows, path);
     const Eigen::Index kept = last - first + 1;
-    out.notes.push_back("window: rows " + std::to_string(first + 1) + ".." +
-                        std::to_string(last + 1) + " kept (" + std::to_string(kept) + " of " +
-                        std::to_string(t.size()) + "; t = " + number(t[first]) + ".." +
-                        number(t[last]) + " s), the rest dropped by " +
-                        (options.window.by_time ? "--time" : "--rows"));
+    out.notes.push_back(
+        "window: rows " + std::to_string(first + 1) + ".." + std::to_string(last + 1) + " kept (" +
+        std::to_string(kept) + " of " + std::to_string(rows.size()) +
+        (t.size() ? "; t = " + number(t[first]) + ".." + number(t[last]) + " s" : std::string()) +
+        "), the rest dropped by " + (options.window.by_time ? "--time" : "--rows"));
     table.data = table.data.middleRows(first, kept).eval();
     if (!table.lines.empty()) {
       table.lines = std::vector<long>(table.lines.begin() + first, table.lines.begin() + last + 1);
     }
-    t = t.segment(first, kept).eval();
+    if (t.size()) t = t.segment(first, kept).eval();
   }
+  return run;
+}
+
+JointRecord read_joint_record(const std::string& path, const Model& model,
+                              const RunFileOptions& options, RunFileReport* report) {
+  const int n = model.dof();
+  const Eigen::VectorXd scale = torque_scale(options.torque_scale, n);
+  const Eigen::VectorXd bias = torque_bias_vector(model, options.torque_bias);
+  RunFileReport local;
+  RunFileReport& out = report ? *report : local;
+  RunTable run = read_run_table(path, options, out);
+  const CsvTable& table = run.table;
+  const Eigen::VectorXd& t = run.t;
+  std::vector<std::string> names;
+  for (const Joint& j : model.joints) names.push_back(j.name);
+  auto has = [&](const char* prefix) { return has_joint_columns(table.columns, names, prefix); };
   JointRecord r;
   r.t = t;
   const bool joint_q = has("q"), motor_q = has("qm");
@@ -200,6 +324,14 @@ JointRecord read_joint_record(const std::string& path, const Model& model,
     for (int j = 0; j < n; ++j) k += (j ? "," : "") + number(scale[j]);
     out.notes.push_back(std::string("torque scale: ") + (motor_tau ? "taum_j" : "tau_j") +
                         " = K_j * column, K = " + k);
+  }
+  if (!options.torque_bias.empty()) {
+    // A constant sensor bias is known here, not estimated: the offset friction term Fo would
+    // estimate it instead (and absorb any other constant torque with it).
+    r.tau.rowwise() -= bias.transpose();
+    std::string b;
+    for (int j = 0; j < n; ++j) b += (j ? "," : "") + number(bias[j]);
+    out.notes.push_back("torque bias: tau_j -= b_j (--torque-bias), b = " + b);
   }
   if (has("dq")) r.dq = joint_signal(table, names, "dq");
   if (has("ddq")) r.ddq = joint_signal(table, names, "ddq");

@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/dynamics/kinematics.hpp"
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/recursive_least_squares.hpp"
@@ -292,16 +293,16 @@ EquationBlock load_equations(const SensorMotion& motion,
   const double span = motion.t(m - 1) - motion.t(0);
   const double step = span / static_cast<double>(std::max<Eigen::Index>(m - 1, 1));
   if (!(options.interval >= step) || !std::isfinite(options.interval)) {
-    throw UsageError("--interval " + std::to_string(options.interval) +
-                     " s is shorter than one sample step (" + std::to_string(step) +
+    throw UsageError("--interval " + short_number(options.interval) +
+                     " s is shorter than one sample step (" + short_number(step) +
                      " s); give a window of several samples");
   }
   const auto per_window =
       std::max<Eigen::Index>(1, static_cast<Eigen::Index>(std::llround(options.interval / step)));
   const Eigen::Index windows = (m - 1) / per_window;
   if (6 * windows < p + 1) {
-    throw Error("the run of " + std::to_string(span) + " s gives " + std::to_string(windows) +
-                " integration windows of " + std::to_string(options.interval) + " s, too few for " +
+    throw Error("the run of " + short_number(span) + " s gives " + std::to_string(windows) +
+                " integration windows of " + short_number(options.interval) + " s, too few for " +
                 std::to_string(p) + " parameters; shorten --interval or record a longer run");
   }
   resize(windows);
@@ -358,13 +359,13 @@ LoadPhysics load_physics(const Eigen::Ref<const Eigen::VectorXd>& phi, bool with
     out.violated =
         "inertia about the centre of mass positive definite (smallest principal "
         "moment " +
-        std::to_string(d(0)) + " kg m^2)";
+        short_number(d(0)) + " kg m^2)";
     return out;
   }
   // Principal moments of a real body: each at most the sum of the other two.
   if (!(d(2) <= d(0) + d(1))) {
-    out.violated = "triangle inequality of the principal moments (" + std::to_string(d(2)) + " > " +
-                   std::to_string(d(0)) + " + " + std::to_string(d(1)) + " kg m^2)";
+    out.violated = "triangle inequality of the principal moments (" + short_number(d(2)) + " > " +
+                   short_number(d(0)) + " + " + short_number(d(1)) + " kg m^2)";
     return out;
   }
   out.consistent = true;
@@ -403,12 +404,23 @@ void rls_residual_statistics(const EquationBlock& block, const EstimationOptions
   e.group_relative_error = (e2.array() / y2.array().max(1e-300)).sqrt();
 }
 
+// Joint torques determine only combinations of a robot's parameters, and of a load's when the
+// runs do not move every joint that carries it.
+const char* const kTorqueRemedy =
+    "the joint torques of these runs do not determine them alone (the robot's own parameters "
+    "need not be: only the load's are reported); load parameters among them are listed under "
+    "not_excited: a run that moves the load's joints more, or a wrist force/torque sensor "
+    "(--sensor-link), determines them";
+
 // The block's estimate by the estimator of `options`, with the HAC sandwich when asked.
+// `remedy`: what the user of dynid payload can do about undetermined columns (the estimator's
+// "regroup" means nothing to someone who gave a run).
 Estimate estimate_block(const EquationBlock& block, const LoadIdentificationOptions& options,
-                        Eigen::MatrixXd* history) {
+                        Eigen::MatrixXd* history, const std::string& remedy) {
   EstimationOptions estimation;
   estimation.confidence_level = options.confidence_level;
   estimation.names = block.columns;
+  estimation.rank_deficient_remedy = remedy;
   Estimate estimate;
   if (options.estimator == LoadEstimator::kOls) {
     estimate = ordinary_least_squares(block.W, block.y, block.group, estimation);
@@ -442,15 +454,15 @@ Estimate estimate_block(const EquationBlock& block, const LoadIdentificationOpti
 // The mass checks of identify_load: no load, or the wrench logged with the other sign.
 void check_mass(const Estimate& e) {
   if (e.ci_upper(0) < 0.0) {
-    throw Error("the identified mass is negative (" + std::to_string(e.x(0)) + " kg, interval " +
-                std::to_string(e.ci_lower(0)) + ".." + std::to_string(e.ci_upper(0)) +
+    throw Error("the identified mass is negative (" + short_number(e.x(0)) + " kg, interval " +
+                short_number(e.ci_lower(0)) + ".." + short_number(e.ci_upper(0)) +
                 "): the wrench was logged as the force on the load, not on the sensor; give "
                 "--wrench-sign -1");
   }
   if (!(e.ci_lower(0) > 0.0)) {
-    throw Error("the data show no load: the mass " + std::to_string(e.x(0)) +
-                " kg is not distinguishable from zero (interval " + std::to_string(e.ci_lower(0)) +
-                ".." + std::to_string(e.ci_upper(0)) +
+    throw Error("the data show no load: the mass " + short_number(e.x(0)) +
+                " kg is not distinguishable from zero (interval " + short_number(e.ci_lower(0)) +
+                ".." + short_number(e.ci_upper(0)) +
                 "); check that a load was gripped and that the data columns are the right ones");
   }
 }
@@ -505,11 +517,28 @@ CutoffSelection select_load_cutoff(const Model& model, const SensorMount& mount,
   return select_cutoff_held_out(record, signal, build, "wrench", products);
 }
 
+PreparedLoadRun prepare_sensor_run(const Model& model, const SensorMount& mount,
+                                   const JointRecord& record,
+                                   const Eigen::Ref<const Eigen::MatrixXd>& wrench,
+                                   const SignalOptions& signal,
+                                   const LoadEquationOptions& equations,
+                                   std::vector<std::pair<std::string, std::string>>& choices) {
+  const CutoffSelection cutoff =
+      select_load_cutoff(model, mount, record, wrench, signal, equations);
+  PreparedLoadRun run = prepare_load_run(record, wrench, cutoff.signal, choices);
+  echo_cutoff_selection(cutoff, choices);
+  return run;
+}
+
 LoadIdentificationResult identify_load(const EquationBlock& block,
                                        const LoadIdentificationOptions& options) {
   LoadIdentificationResult out;
   out.names = block.columns;
-  out.estimate = estimate_block(block, options, &out.history);
+  out.estimate = estimate_block(
+      block, options, &out.history,
+      "the run does not excite them: record one that turns the sensor through more orientations "
+      "with larger angular velocities and accelerations, or give --static to identify m and mc "
+      "only; they are listed under not_excited");
   const Estimate& e = out.estimate;
   if (std::any_of(e.unidentifiable.begin(), e.unidentifiable.end(),
                   [](Eigen::Index j) { return j < 4; })) {
@@ -640,7 +669,7 @@ LoadIdentificationResult identify_load_from_torques(const Model& model, int link
   for (const auto& name : load_parameter_names({})) block.columns.push_back("load_" + name);
   LoadIdentificationOptions batch = options;
   batch.record_history = false;
-  return load_result_from_torques(estimate_block(block, batch, nullptr), p);
+  return load_result_from_torques(estimate_block(block, batch, nullptr, kTorqueRemedy), p);
 }
 
 LoadIdentificationResult identify_load_from_unexplained_torques(
@@ -695,7 +724,7 @@ LoadIdentificationResult identify_load_from_unexplained_torques(
   }
   LoadIdentificationOptions batch = options;
   batch.record_history = false;
-  return load_result_from_torques(estimate_block(block, batch, nullptr), 0);
+  return load_result_from_torques(estimate_block(block, batch, nullptr, kTorqueRemedy), 0);
 }
 
 }  // namespace dynid

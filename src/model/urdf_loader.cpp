@@ -87,7 +87,7 @@ LinkParams urdf_link_params(const urdf::Link& link) {
   I_in << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
   const Eigen::Matrix3d I_C = o.R * I_in * o.R.transpose();
   if (!(in.mass >= 0.0)) {
-    throw Error("link '" + link.name + "' has negative mass " + std::to_string(in.mass) +
+    throw Error("link '" + link.name + "' has negative mass " + short_number(in.mass) +
                 " kg; give a mass >= 0 in its <inertial> block");
   }
   return link_params_from_com(in.mass, o.p, I_C);

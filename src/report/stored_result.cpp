@@ -1,11 +1,13 @@
 #include "dynid/report/stored_result.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/identification/known_friction.hpp"
 
 namespace dynid {
@@ -36,11 +38,11 @@ ParameterLayout stored_layout(const ResultFileOptions& file) {
 
 Error stored_option_error(const UsageError& e, const std::string& path) {
   static const std::pair<const char*, const char*> kKeys[] = {
-      {"--friction", "friction"},
-      {"--filter", "filter"},
-      {"--cutoff", "cutoff_hz"},
-      {"--torque-offset", "torque_offset_s"},
-      {"--zero-velocity", "zero_velocity"}};
+      {"--friction", "friction"},         {"--filter", "filter"},
+      {"--cutoff", "cutoff_hz"},          {"--torque-offset", "torque_offset_s"},
+      {"--time-shift", "time_shift_s"},   {"--zero-velocity", "zero_velocity"},
+      {"--columns", "columns"},           {"--rate", "rate_hz"},
+      {"--torque-scale", "torque_scale"}, {"--torque-bias", "torque_bias"}};
   std::string text = e.what();
   for (const auto& [flag, key] : kKeys) {
     if (text.rfind(flag, 0) == 0) {
@@ -72,12 +74,21 @@ StoredIdentifyOptions options_of_stored_result(const IdentifiedResultFile& ident
       o.signal.cutoff_hz = *overrides.cutoff;
     } else if (identified.cutoff_hz > 0.0) {
       o.signal.cutoff_hz = identified.cutoff_hz;
+      o.signal.cutoff_source = "as identify used it";
       out.notes.push_back("cut-off as identify used it (stored in '" + path + "')");
     } else {
       o.signal.cutoff_hz = file.get("cutoff_hz", 0.0);
+      o.signal.cutoff_source = "as given to identify";
     }
     o.signal.savitzky_golay = file.get("savitzky_golay", false);
-    o.signal.torque_time_offset = file.get("torque_offset_s", 0.0);
+    // time_shift_s since issue 26 item 7; older results have only torque_offset_s.
+    if (overrides.time_shift) {
+      o.signal.torque_time_offset = *overrides.time_shift;
+    } else {
+      o.signal.torque_time_offset = file.get("time_shift_s", file.get("torque_offset_s", 0.0));
+      if (o.signal.torque_time_offset != 0.0)
+        out.notes.push_back("--time-shift as given to identify (stored in '" + path + "')");
+    }
     o.signal.filter_coulomb_columns = file.get("filter_coulomb_columns", false);
     // The rows left out are those below the thresholds identify used (stored in the result), not
     // thresholds recomputed from this run.
@@ -85,12 +96,31 @@ StoredIdentifyOptions options_of_stored_result(const IdentifiedResultFile& ident
       o.signal.zero_velocity = overrides.zero_velocity;
     } else if (static_cast<int>(identified.zero_velocity_threshold.size()) == dof) {
       o.signal.zero_velocity = identified.zero_velocity_threshold;
+      o.signal.zero_velocity_source = "as identify used them";
       if (*std::max_element(o.signal.zero_velocity.begin(), o.signal.zero_velocity.end()) > 0.0) {
         out.notes.push_back("zero-velocity thresholds as identify used them (stored in '" + path +
                             "')");
       }
     } else {
       o.signal.zero_velocity = file.get("zero_velocity", std::vector<double>{});
+      o.signal.zero_velocity_source = "as given to identify";
+    }
+    // How identify read its run: a log of the same recorder is read the same way (a different
+    // rename silently compares other columns).
+    if (!overrides.columns_given) {
+      out.columns = parse_column_mapping(file.get("columns", std::string()));
+      if (!out.columns.empty())
+        out.notes.push_back("--columns as given to identify (stored in '" + path + "')");
+    }
+    if (!overrides.rate_given) {
+      out.rate_hz = file.get("rate_hz", 0.0);
+      if (!(out.rate_hz >= 0.0) || !std::isfinite(out.rate_hz))
+        throw UsageError("--rate " + short_number(out.rate_hz) + " is not a sample rate in Hz");
+    }
+    if (!overrides.torque_bias_given) {
+      out.torque_bias = parse_torque_bias(file.get("torque_bias", std::string()));
+      if (!out.torque_bias.empty())
+        out.notes.push_back("--torque-bias as given to identify (stored in '" + path + "')");
     }
   } catch (const UsageError& e) {
     throw stored_option_error(e, path);
@@ -102,6 +132,16 @@ StoredIdentifyOptions options_of_stored_result(const IdentifiedResultFile& ident
     }
   }
   return out;
+}
+
+void StoredIdentifyOptions::apply_to(RunFileOptions& file) const {
+  if (!columns.empty()) file.columns = columns;
+  if (rate_hz > 0.0) {
+    file.rate_hz = rate_hz;
+    file.rate_given = false;
+  }
+  if (!torque_scale.empty()) file.torque_scale = torque_scale;
+  if (!torque_bias.empty()) file.torque_bias = torque_bias;
 }
 
 void add_stored_known_friction(const IdentifiedResultFile& identified, const std::string& path,

@@ -10,6 +10,7 @@
 #include <unsupported/Eigen/FFT>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 #include "dynid/signal/zero_phase_filter.hpp"
 
 namespace dynid {
@@ -21,7 +22,7 @@ constexpr Eigen::Index kMinSamples = 129;
 
 void check_rate(double rate_hz) {
   if (!(rate_hz > 0.0) || !std::isfinite(rate_hz)) {
-    throw Error("sample rate " + std::to_string(rate_hz) + " Hz is not > 0; pass the data's rate");
+    throw Error("sample rate " + short_number(rate_hz) + " Hz is not > 0; pass the data's rate");
   }
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
@@ -47,6 +48,25 @@ std::optional<CorruptSample> find_corrupt_sample(const Eigen::Ref<const Eigen::M
   return first;
 }
 
+std::optional<std::string> check_sample_rate(const Eigen::Ref<const Eigen::VectorXd>& t,
+                                             const PlausibilityOptions& options) {
+  const Eigen::Index m = t.size();
+  if (m < 2 || !(t[m - 1] > t[0])) return std::nullopt;
+  const double rate = static_cast<double>(m - 1) / (t[m - 1] - t[0]);
+  if (rate < options.min_rate_hz || rate > options.max_rate_hz) {
+    throw Error("the time stamps give a sample rate of " + short_number(rate) + " Hz, outside " +
+                short_number(options.min_rate_hz) + " Hz to " + short_number(options.max_rate_hz) +
+                " Hz: t must be in seconds (divide milliseconds by 1000, microseconds by 1e6) "
+                "or --rate must be in Hz");
+  }
+  if (rate < options.low_rate_hz) {
+    return "low sample rate " + short_number(rate) +
+           " Hz: accelerations from so few samples are unreliable; if t is in milliseconds, "
+           "convert it to seconds";
+  }
+  return std::nullopt;
+}
+
 std::vector<std::string> check_run_plausibility(const Eigen::Ref<const Eigen::VectorXd>& t,
                                                 const Eigen::Ref<const Eigen::MatrixXd>& q,
                                                 const Eigen::Ref<const Eigen::MatrixXd>& tau,
@@ -54,21 +74,7 @@ std::vector<std::string> check_run_plausibility(const Eigen::Ref<const Eigen::Ve
                                                 const PlausibilityOptions& options) {
   std::vector<std::string> warnings;
   const Eigen::Index m = t.size();
-  if (m >= 2 && t[m - 1] > t[0]) {
-    const double rate = static_cast<double>(m - 1) / (t[m - 1] - t[0]);
-    if (rate < options.min_rate_hz || rate > options.max_rate_hz) {
-      throw Error("the time stamps give a sample rate of " + short_number(rate) + " Hz, outside " +
-                  short_number(options.min_rate_hz) + " Hz to " +
-                  short_number(options.max_rate_hz) +
-                  " Hz: t must be in seconds (divide milliseconds by 1000, microseconds by 1e6) "
-                  "or --rate must be in Hz");
-    }
-    if (rate < options.low_rate_hz) {
-      warnings.push_back("low sample rate " + short_number(rate) +
-                         " Hz: accelerations from so few samples are unreliable; if t is in "
-                         "milliseconds, convert it to seconds");
-    }
-  }
+  if (auto w = check_sample_rate(t, options)) warnings.push_back(std::move(*w));
   if (m == 0 || q.cols() == 0) return warnings;
   std::vector<std::string> zero_torque, still;
   for (Eigen::Index j = 0; j < tau.cols(); ++j) {

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 
 namespace dynid {
 
@@ -14,7 +15,7 @@ constexpr double kPi = 3.14159265358979323846;
 void check_non_negative(double v, const char* field) {
   if (!(v >= 0.0) || !std::isfinite(v))
     throw Error(std::string("sensor option ") + field + " must be finite and >= 0 (got " +
-                std::to_string(v) + ")");
+                short_number(v) + ")");
 }
 
 }  // namespace

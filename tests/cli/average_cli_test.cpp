@@ -73,6 +73,55 @@ TEST_F(AverageCli, WritesTheMeanPeriodAndTheNoiseOfEveryChannel) {
   EXPECT_EQ(header, "t,qr1,q1,tau1");
 }
 
+// Issue 26 item 2: average takes the run flags of every command that reads a run. The run
+// written here without t, its torque logged as tau1/2 + 0.25: --rate 200 gives its time,
+// --torque-scale 2 --torque-bias 1=0.5 give tau1 back (noise std 0.1, mean 0 over a period of a
+// sine), --rows keeps the rows asked for.
+TEST_F(AverageCli, TakesTheRunFlags) {
+  std::ifstream in(work("run.csv"));
+  std::ofstream logged(work("logged.csv"));
+  std::string line;
+  std::getline(in, line);
+  logged << "qr1,q1,cur1\n";
+  while (std::getline(in, line)) {
+    std::stringstream s(line);
+    std::string t, qr, q, tau;
+    std::getline(s, t, ',');
+    std::getline(s, qr, ',');
+    std::getline(s, q, ',');
+    std::getline(s, tau, ',');
+    logged.precision(17);
+    logged << qr << ',' << q << ',' << std::stod(tau) / 2 + 0.25 << '\n';
+  }
+  logged.close();
+  const auto r = run("average --data " + work("logged.csv") +
+                     " --rate 200 --columns cur1=tau1 "
+                     "--torque-scale 2 --torque-bias 1=0.5 --rows 1:1400 --period 0.7525 --out " +
+                     work("avg.csv") + " --json " + work("noise.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(std::ifstream(work("noise.json")));
+  // 1400 rows at 200 Hz span 6.995 s: 9 periods of 0.7525 s (the whole run holds 10).
+  EXPECT_EQ(j["periods"], 9);
+  ASSERT_EQ(j["channels"][2]["name"], "tau1");
+  const double n = j["residual_samples"].get<double>();
+  EXPECT_NEAR(j["channels"][2]["std"].get<double>(), 0.1, 4 * 0.1 / std::sqrt(2 * n));
+  std::ifstream avg(work("avg.csv"));
+  std::getline(avg, line);
+  double sum = 0.0;
+  int rows = 0;
+  while (std::getline(avg, line)) {
+    sum += std::stod(line.substr(line.rfind(',') + 1));
+    ++rows;
+  }
+  ASSERT_GT(rows, 100);
+  EXPECT_NEAR(sum / rows, 0.0, 0.02);  // without the bias: 0.5 (times the scale)
+  const auto none =
+      run("average --data " + work("logged.csv") + " --period 0.7525 --out " + work("x.csv"));
+  EXPECT_EQ(none.code, 2) << none.err;
+  EXPECT_NE(none.err.find("--rate HZ"), std::string::npos) << none.err;
+  EXPECT_FALSE(fs::exists(work("x.csv")));
+}
+
 TEST_F(AverageCli, APeriodWithoutTwoPeriodsIsOneErrorLineAndNothingWritten) {
   const auto r = run("average --data " + work("run.csv") + " --period 5 --out " + work("avg.csv") +
                      " --json " + work("noise.json"));

@@ -213,7 +213,7 @@ TEST_F(Contract, StreamRejectsTheFlagsItCannotHonour) {
   const std::string out = work("result.json");
   const std::string stream =
       "identify --robot planar2 --stream --filter none --data " + data + " --out " + out + " ";
-  for (const std::string flag : {"--torque-offset 0.005", "--decimate 2", "--trim 3", "--savgol",
+  for (const std::string flag : {"--time-shift 0.005", "--decimate 2", "--trim 3", "--savgol",
                                  "--filter-coulomb", "--cutoff 5"}) {
     const std::string name = flag.substr(0, flag.find(' '));
     expect_error(run(stream + flag), 2, name + " cannot be used with --stream");

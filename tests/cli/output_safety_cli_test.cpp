@@ -167,6 +167,10 @@ TEST(FileFlags, EveryFlagThatNamesAFileIsListed) {
       "validate --columns",      // the same
       "identify --rate",         // the sample rate "when the file has no t column"
       "validate --rate",         // the same
+      "payload --columns",       // the run flags are one definition (apps/dynid/run_flags.cpp)
+      "payload --rate",          // the same
+      "average --columns",       // the same
+      "average --rate",          // the same
       "simulate --sensor-pose",  // numbers (a pose in the link frame)
       "payload --sensor-pose",   // the same
       "validate --controller",   // a controller name ("default: the one named in the gains file")

@@ -49,31 +49,9 @@ std::vector<std::vector<double>> csv_rows(const std::string& path, std::string& 
   return rows;
 }
 
-// Closed-form planar2 of examples/robots/planar2.yaml (slender rods: I = m·l²/12 about the centre
-// of mass) on a fixed trajectory.
-struct Sample {
-  double t, q[2], dq[2], ddq[2], tau[2];
-};
-
-Sample planar2_sample(int k, double dt) {
-  dynid::testing::Planar2 arm;
-  arm.I1 = 2.0 / 12;
-  arm.I2 = 1.5 * 0.64 / 12;
-  Sample s{};
-  const double t = k * dt;
-  s.t = t;
-  s.q[0] = std::sin(0.7 * t) + 0.3 * std::sin(2.1 * t);
-  s.q[1] = 0.8 * std::cos(1.3 * t);
-  s.dq[0] = 0.7 * std::cos(0.7 * t) + 0.63 * std::cos(2.1 * t);
-  s.dq[1] = -1.04 * std::sin(1.3 * t);
-  s.ddq[0] = -0.49 * std::sin(0.7 * t) - 1.323 * std::sin(2.1 * t);
-  s.ddq[1] = -1.352 * std::cos(1.3 * t);
-  const Eigen::Vector2d tau =
-      arm.torque({s.q[0], s.q[1]}, {s.dq[0], s.dq[1]}, {s.ddq[0], s.ddq[1]});
-  s.tau[0] = tau[0];
-  s.tau[1] = tau[1];
-  return s;
-}
+// Closed-form planar2 of examples/robots/planar2.yaml on a fixed trajectory (tests/support).
+using Sample = dynid::testing::Planar2Sample;
+using dynid::testing::planar2_sample;
 
 // ZZ1R = ZZ1 + l1²·M2 of the closed-form arm: I1 + m1·c1² + m2·l1².
 constexpr double kZz1r = 2.0 / 12 + 2.0 * 0.25 + 1.5;

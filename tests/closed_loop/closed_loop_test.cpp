@@ -25,23 +25,8 @@ struct ClosedRun {
   ReferenceRecord reference;
 };
 
-// Plain PID (no feed-forward), noise fed back, `periods` periods after a dropped start-up one.
-ClosedRun plain_pid_run(const Model& m, unsigned seed, int periods, double q_noise,
-                        double tau_noise) {
-  const TrajectorySamples tr =
-      sample_trajectory(FourierTrajectory(testing::planar2_reference()), kRate, false);
-  SimulateOptions so = testing::noisy_sensors(q_noise, tau_noise, seed, periods + 1);
-  so.feed_forward = FeedForward::kNone;
-  so.plant.engine = PlantEngine::kNative;
-  const ClosedLoopResult r = simulate_reference(m, tr.t, tr.q, tr.dq, tr.ddq, so);
-  const Eigen::Index skip = tr.t.size(), rows = r.t.size() - skip;
-  ClosedRun out;
-  out.run = {r.t.tail(rows), r.q.bottomRows(rows), {}, {}, r.tau.bottomRows(rows)};
-  out.reference.qr = r.qr.bottomRows(rows);
-  return out;
-}
-
-// plain_pid_run() with a reference of `harmonics` ≤ 4 (the planar2 reference truncated).
+// Plain PID (no feed-forward), noise fed back, `periods` periods after a dropped start-up one, on
+// the planar2 test reference truncated to its first `harmonics` (≤ 4).
 ClosedRun plain_pid_run_harmonics(const Model& m, unsigned seed, int periods, int harmonics,
                                   double q_noise, double tau_noise) {
   FourierCoefficients c = testing::planar2_reference();
@@ -59,6 +44,11 @@ ClosedRun plain_pid_run_harmonics(const Model& m, unsigned seed, int periods, in
   out.run = {r.t.tail(rows), r.q.bottomRows(rows), {}, {}, r.tau.bottomRows(rows)};
   out.reference.qr = r.qr.bottomRows(rows);
   return out;
+}
+
+ClosedRun plain_pid_run(const Model& m, unsigned seed, int periods, double q_noise,
+                        double tau_noise) {
+  return plain_pid_run_harmonics(m, seed, periods, 4, q_noise, tau_noise);
 }
 
 IdentifyOptions closed_options(ClosedLoopMethod method) {

@@ -387,5 +387,47 @@ TEST(OrdinaryLeastSquares, SquareSystemHasNoStatistics) {
   EXPECT_FALSE(e.summary.warnings.empty());
 }
 
+// Issue 26 item 6: the warnings a user reads give numbers in 4 significant digits (not
+// "69928.253607 exceeds 10000.000000") and end a rank deficiency with the caller's remedy.
+TEST(OrdinaryLeastSquares, WarningsUseShortNumbersAndTheCallersRemedy) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> g;
+  Eigen::MatrixXd W(200, 3);
+  for (Eigen::Index i = 0; i < W.rows(); ++i) {
+    const double a = g(rng), b = g(rng);
+    W.row(i) << a, b, a + 1e-6 * b;  // cond(W) ~ 1e6: above the 1e4 warning
+  }
+  Eigen::VectorXd y = W * Eigen::Vector3d(1, 2, 3);
+  for (Eigen::Index i = 0; i < y.size(); ++i) y[i] += 0.01 * g(rng);
+  const Estimate e = ordinary_least_squares(W, y);
+  std::string condition;
+  for (const auto& w : e.summary.warnings)
+    if (w.rfind("condition number ", 0) == 0) condition = w;
+  ASSERT_FALSE(condition.empty()) << ::testing::PrintToString(e.summary.warnings);
+  EXPECT_NE(condition.find(" exceeds 1e+04:"), std::string::npos) << condition;
+  const std::string value = condition.substr(17, condition.find(' ', 17) - 17);
+  // At most 4 significant digits: the mantissa before any exponent has at most 5 characters.
+  EXPECT_LE(value.substr(0, value.find('e')).size(), 5u) << condition;
+  EXPECT_NEAR(std::stod(value), e.summary.condition_number, 1e-3 * e.summary.condition_number);
+
+  Eigen::MatrixXd Z = W;
+  Z.col(2).setZero();  // a column the data do not determine
+  EstimationOptions options;
+  options.names = {"a", "b", "c"};
+  const auto rank_warning = [](const Estimate& x) {
+    for (const auto& w : x.summary.warnings)
+      if (w.rfind("W is rank deficient", 0) == 0) return w;
+    return std::string();
+  };
+  const std::string plain = rank_warning(ordinary_least_squares(Z, y, Eigen::VectorXi(), options));
+  EXPECT_NE(plain.find("regroup them into base parameters"), std::string::npos) << plain;
+  options.rank_deficient_remedy = "record a longer run";
+  const std::string own = rank_warning(ordinary_least_squares(Z, y, Eigen::VectorXi(), options));
+  EXPECT_NE(own.find("parameters c are not identifiable individually; record a longer run"),
+            std::string::npos)
+      << own;
+  EXPECT_EQ(own.find("regroup"), std::string::npos) << own;
+}
+
 }  // namespace
 }  // namespace dynid

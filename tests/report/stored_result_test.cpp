@@ -85,16 +85,24 @@ TEST(OptionsOfStoredResult, RebuildsTheCommandLinesOptionsAndWhatIdentifyChose) 
   EXPECT_DOUBLE_EQ(o.signal.torque_time_offset, 0.001);
   EXPECT_EQ(o.signal.zero_velocity, (std::vector<double>{0.01, 0.02}));
   EXPECT_EQ(s.torque_scale, (std::vector<double>{2.0, 3.0}));
-  EXPECT_EQ(s.notes.size(), 3u);  // cut-off, thresholds, torque scale: each said once
+  // cut-off, thresholds, time shift (issue 26 item 7), torque scale: each said once
+  EXPECT_EQ(s.notes.size(), 4u);
+  // A result before time_shift_s has only torque_offset_s; a newer one wins with its own key.
+  IdentifiedResultFile newer = f;
+  newer.options["time_shift_s"] = 0.002;
+  EXPECT_DOUBLE_EQ(options_of_stored_result(newer, "r.json", 2).options.signal.torque_time_offset,
+                   0.002);
 
   StoredOptionOverrides over;
   over.cutoff = 5.0;
   over.zero_velocity = {0.1};
   over.torque_scale_given = true;
+  over.time_shift = 0.0;
   const StoredIdentifyOptions given = options_of_stored_result(f, "r.json", 2, over);
   EXPECT_DOUBLE_EQ(given.options.signal.cutoff_hz, 5.0);
   EXPECT_EQ(given.options.signal.zero_velocity, (std::vector<double>{0.1}));
   EXPECT_TRUE(given.torque_scale.empty());
+  EXPECT_DOUBLE_EQ(given.options.signal.torque_time_offset, 0.0);
   EXPECT_TRUE(given.notes.empty());
 }
 

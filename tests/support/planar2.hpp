@@ -48,4 +48,31 @@ struct Planar2 {
   }
 };
 
+// One sample of a fixed excitation of examples/robots/planar2.yaml (slender rods: I = m·l²/12
+// about the centre of mass), torques from the closed form above: the oracle of the CLI tests that
+// read real-log style runs (real_logs_cli_test.cpp, run_flags_cli_test.cpp).
+struct Planar2Sample {
+  double t, q[2], dq[2], ddq[2], tau[2];
+};
+
+inline Planar2Sample planar2_sample(int k, double dt) {
+  Planar2 arm;
+  arm.I1 = 2.0 / 12;
+  arm.I2 = 1.5 * 0.64 / 12;
+  Planar2Sample s{};
+  const double t = k * dt;
+  s.t = t;
+  s.q[0] = std::sin(0.7 * t) + 0.3 * std::sin(2.1 * t);
+  s.q[1] = 0.8 * std::cos(1.3 * t);
+  s.dq[0] = 0.7 * std::cos(0.7 * t) + 0.63 * std::cos(2.1 * t);
+  s.dq[1] = -1.04 * std::sin(1.3 * t);
+  s.ddq[0] = -0.49 * std::sin(0.7 * t) - 1.323 * std::sin(2.1 * t);
+  s.ddq[1] = -1.352 * std::cos(1.3 * t);
+  const Eigen::Vector2d tau =
+      arm.torque({s.q[0], s.q[1]}, {s.dq[0], s.dq[1]}, {s.ddq[0], s.ddq[1]});
+  s.tau[0] = tau[0];
+  s.tau[1] = tau[1];
+  return s;
+}
+
 }  // namespace dynid::testing

@@ -36,6 +36,10 @@ struct EstimationOptions {
   double weak_direction_threshold = 0.5;
   /// Column (parameter) names used in warnings; empty selects "x<j>". Size 0 or p.
   std::vector<std::string> names;
+  /// What the user can do about columns the data do not determine, in the caller's terms (a
+  /// command's flags, a better run), ending the rank-deficiency warning; empty: regroup them into
+  /// base parameters or drop the dependent columns (the estimator's own view).
+  std::string rank_deficient_remedy;
 };
 
 /// What an estimator did (Ceres style): sizes, numerical outcome and warnings.

@@ -35,6 +35,9 @@ struct SignalOptions {
   /// end of the band where the position spectrum stands 20 dB above its noise floor, in
   /// [1 Hz, min(20 Hz, rate/10)].
   double cutoff_hz = 0.0;
+  /// Where a non-zero cutoff_hz comes from, as the echo says it: "given" (the caller's), or e.g.
+  /// "as identify used it" for a value a stored result supplies (never "given" for those).
+  std::string cutoff_source = "given";
   double ripple_db = 0.5;  ///< Chebyshev I passband ripple
   int decimate = 0;        ///< keep every k-th sample; 0 = auto: rate/(10·cutoff), ≥ 1
   int trim = -1;  ///< samples dropped at each end after filtering; −1 = auto: 3·rate/cutoff
@@ -48,6 +51,8 @@ struct SignalOptions {
   /// a low cut-off the filtered torque's smeared Coulomb step otherwise biases Fv high and Fc low
   /// (docs/methods/identification.md, "Friction near zero velocity").
   std::vector<double> zero_velocity;
+  /// Where non-empty zero_velocity thresholds come from, as the echo says it (as cutoff_source).
+  std::string zero_velocity_source = "given";
   /// Automatic zero-velocity rule: fraction of max|dq_j| of the processed record (the band where
   /// real joint friction is not Fc·sign(dq): pre-sliding, Stribeck; 1 % matches FIGAROH's TX40).
   double zero_velocity_fraction = 0.01;

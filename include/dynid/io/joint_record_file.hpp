@@ -29,6 +29,20 @@ struct RunFileOptions {
   /// or n values. Applied to the column as logged (motor side for taum*), before the transmission.
   std::vector<double> torque_scale;
   RunWindow window;  ///< part of the run kept (`--rows A:B`, `--time T0:T1`); empty = all
+  /// Constant sensor bias b_j subtracted from joint j's torque (`--torque-bias J=VALUE,...`): J is
+  /// a joint number counted from 1 or a joint name, VALUE [N·m, or N for a prismatic joint] on the
+  /// joint side, after the torque scale and the transmission. Joints not named keep 0.
+  std::vector<std::pair<std::string, double>> torque_bias;
+  /// false when rate_hz is not the user's (a rate stored in a result): a t column that makes it
+  /// useless is then a note, not a warning about a flag nobody gave.
+  bool rate_given = true;
+};
+
+/// A run's table after the file options that need no robot model: columns renamed (or named by
+/// position), time from `t` or the rate, the window kept (read_run_table()).
+struct RunTable {
+  CsvTable table;     ///< the kept rows, columns as renamed
+  Eigen::VectorXd t;  ///< time stamps [s] of the kept rows; empty when the run has none
 };
 
 /// What read_joint_record did, for the echo on stderr: notes (one line per processing choice) and
@@ -43,6 +57,30 @@ struct RunFileReport {
 /// two numbers around ':', non-integer or < 1 rows, NaN/Inf, or a first end after the last.
 RunWindow parse_run_window(const std::string& text, bool by_time, const std::string& flag);
 
+/// Parses `--torque-bias J=VALUE,...` (J a joint number from 1 or a joint name). Throws
+/// dynid::UsageError naming the flag for an entry that is not J=VALUE with a finite VALUE, or a
+/// joint given twice.
+std::vector<std::pair<std::string, double>> parse_torque_bias(const std::string& text);
+
+/// The per-joint bias vector of `entries` (parse_torque_bias()) for `model`. Throws
+/// dynid::UsageError naming --torque-bias and the model's joints for a J that is no joint.
+Eigen::VectorXd torque_bias_vector(const Model& model,
+                                   const std::vector<std::pair<std::string, double>>& entries);
+
+/// For a command without a robot model (average): options.torque_scale and options.torque_bias
+/// (joints by number only) applied to the numbered columns tau1..taun (or taum1..taumn) of `run`,
+/// n their count; nothing without either option. Throws dynid::UsageError naming the flag when
+/// the table has no such columns, for a count that is not 1 or n, or a joint that is not 1..n.
+void scale_torque_columns(RunTable& run, const RunFileOptions& options, RunFileReport& report);
+
+/// Reads `path` as a run with the options that need no model: options.columns, time from `t` or
+/// options.rate_hz, options.window. With `need_time` false a run without time information is read
+/// with an empty RunTable::t (a --time window then needs one). Throws as read_joint_record().
+/// Notes and warnings go to `report`. Commands that read other columns than a joint record's
+/// (payload's wrench, average's every column) read their run through this.
+RunTable read_run_table(const std::string& path, const RunFileOptions& options,
+                        RunFileReport& report, bool need_time = true);
+
 /// True when `--columns` names columns by position only (every `from` a positive integer);
 /// throws dynid::UsageError when positions and names are mixed.
 bool columns_by_position(const ColumnMapping& mapping);
@@ -51,7 +89,8 @@ bool columns_by_position(const ColumnMapping& mapping);
 /// (joint side) or `qm*` (motor side, converted with the model's transmission,
 /// q = N⁻¹·qm + q_offset), torques from `tau*` or `taum*` (tau = Nᵀ·taum), and `dq*`, `ddq*` when
 /// present (used as given). Columns `q<j>` or `q_<joint name>`; other columns ignored.
-/// Then keeps options.window and scales the torques by options.torque_scale.
+/// Then keeps options.window, scales the torques by options.torque_scale and subtracts
+/// options.torque_bias.
 /// Throws dynid::Error naming the file for missing columns (and the fix), no time information,
 /// both joint- and motor-side columns, or bad numbers (see read_csv); dynid::UsageError for a
 /// torque scale that is not 1 or n finite non-zero numbers, and for a window that is outside the

@@ -136,6 +136,16 @@ CutoffSelection select_load_cutoff(const Model& model, const SensorMount& mount,
                                    const LoadEquationOptions& equations,
                                    const CutoffSelectionOptions& selection = {});
 
+/// prepare_load_run() of a sensor run on the robot with the cut-off of select_load_cutoff() when
+/// `signal` asks for the automatic one, its reason in `choices` (the one preparation `dynid
+/// payload --sensor-link` and Python's payload() share). Throws as both.
+PreparedLoadRun prepare_sensor_run(const Model& model, const SensorMount& mount,
+                                   const JointRecord& record,
+                                   const Eigen::Ref<const Eigen::MatrixXd>& wrench,
+                                   const SignalOptions& signal,
+                                   const LoadEquationOptions& equations,
+                                   std::vector<std::pair<std::string, std::string>>& choices);
+
 /// Estimator of identify_load.
 enum class LoadEstimator {
   kOls,  ///< ordinary least squares (QR)

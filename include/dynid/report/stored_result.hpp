@@ -19,6 +19,7 @@
 #include "dynid/identification/option_text.hpp"
 #include "dynid/identification/record.hpp"
 #include "dynid/identification/validation.hpp"
+#include "dynid/io/joint_record_file.hpp"
 #include "dynid/model/model.hpp"
 #include "dynid/physical/completed_model.hpp"
 #include "dynid/regressor/parameter_layout.hpp"
@@ -46,16 +47,21 @@ struct ResultFileOptions {
 };
 
 /// A usage error raised by an option value read from result `path`: the same text with the flag
-/// (--friction, --filter, --cutoff, --torque-offset, --zero-velocity) replaced by its key
+/// (--friction, --filter, --cutoff, --time-shift, --zero-velocity, --columns, --rate,
+/// --torque-scale, --torque-bias) replaced by its key
 /// (options.friction, ...), as a dynid::Error (the file is at fault, exit 1, not 2).
 Error stored_option_error(const UsageError& e, const std::string& path);
 
-/// What the caller sets instead of the stored result (validate's --cutoff, --zero-velocity,
-/// --torque-scale).
+/// What the caller sets instead of the stored result (validate's --cutoff, --zero-velocity and
+/// run flags).
 struct StoredOptionOverrides {
   std::optional<double> cutoff;       ///< low-pass cut-off [Hz]; unset: the one identify used
   std::vector<double> zero_velocity;  ///< per joint [rad/s]; empty: the thresholds identify used
   bool torque_scale_given = false;    ///< true: the caller's torque scale, not the stored one
+  bool columns_given = false;         ///< true: the caller's --columns, not the stored ones
+  bool rate_given = false;            ///< true: the caller's --rate, not the stored one
+  bool torque_bias_given = false;     ///< true: the caller's --torque-bias, not the stored one
+  std::optional<double> time_shift;   ///< [s]; unset: the time shift identify used
 };
 
 /// identify's options as a stored result rebuilds them (StoredIdentifyOptions).
@@ -67,15 +73,25 @@ struct StoredIdentifyOptions {
   /// options.torque_scale as given to identify (empty when none, or when
   /// StoredOptionOverrides::torque_scale_given).
   std::vector<double> torque_scale;
+  /// options.columns as given to identify, parsed (empty when none, or overridden): a log of the
+  /// same recorder is read with the same renames (issue 26 item 3).
+  ColumnMapping columns;
+  double rate_hz = 0.0;  ///< options.rate_hz as given to identify (0 when none, or overridden)
+  /// options.torque_bias as given to identify, parsed (empty when none, or overridden).
+  std::vector<std::pair<std::string, double>> torque_bias;
   std::vector<std::string> notes;  ///< one line per value taken from the file
+
+  /// Sets in `file` each of columns, rate, torque scale and bias that the result stores and the
+  /// caller did not override (a stored rate as not given: RunFileOptions::rate_given false).
+  void apply_to(RunFileOptions& file) const;
 };
 
 /// Rebuilds identify's regressor and signal processing from `identified` (read from `path`) for a
 /// run of a `dof`-joint robot, so that a prediction on another run compares the same kind of rows
-/// as the fit. The friction set is options.friction (text) or, in a Python result,
-/// options.viscous/coulomb/offset/asymmetric (booleans); options.filter is text or a boolean.
-/// Throws dynid::Error naming `path` and the key for a value of the wrong type or an invalid
-/// option in the file.
+/// as the fit, read with the same columns, rate, torque scale and bias. The friction set is
+/// options.friction (text) or, in a Python result, options.viscous/coulomb/offset/asymmetric
+/// (booleans); options.filter is text or a boolean. Throws dynid::Error naming `path` and the key
+/// for a value of the wrong type or an invalid option in the file.
 StoredIdentifyOptions options_of_stored_result(const IdentifiedResultFile& identified,
                                                const std::string& path, int dof,
                                                const StoredOptionOverrides& overrides = {});

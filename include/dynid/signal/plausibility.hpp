@@ -16,9 +16,16 @@ struct PlausibilityOptions {
   double still_range = 1e-4;   ///< a joint whose position range is below this does not move
 };
 
+/// The time-units diagnosis of a run (identify through check_run_plausibility(), validate
+/// through validate_torques(), so that both name the same cause): throws dynid::Error when the
+/// sample rate (m−1)/(t_end − t_0) lies outside [min_rate_hz, max_rate_hz] (time stamps in ms or
+/// µs, or a --rate not in Hz); returns a warning when it is below low_rate_hz.
+std::optional<std::string> check_sample_rate(const Eigen::Ref<const Eigen::VectorXd>& t,
+                                             const PlausibilityOptions& options = {});
+
 /// Checks that a run looks like a robot run in SI units before anything is estimated from it:
-/// the sample rate (m−1)/(t_end − t_0) lies in [min_rate_hz, max_rate_hz] (else the time stamps
-/// are in ms or µs and every parameter would come out 10⁶× off), some torque is non-zero, some
+/// the sample rate passes check_sample_rate() (else the time stamps are in ms or µs and every
+/// parameter would come out 10⁶× off), some torque is non-zero, some
 /// joint moves. t: m strictly increasing time stamps [s]; q, tau: m × n [rad or m, N·m or N];
 /// `joints`: n names for the messages. Throws dynid::Error naming the fault and the fix for the
 /// run as a whole; returns named warnings (one line each) for single joints: torque zero in every
