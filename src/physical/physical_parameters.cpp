@@ -287,9 +287,8 @@ PhysicalFit physical_parameters(const Model& nominal, const BaseParameters& base
 
   ceres::Problem problem;
   auto* data = new ceres::DynamicAutoDiffCostFunction<DataCost, 4>(new DataCost{
-      map, base,
-      L.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(base.rank, base.rank)),
-      theta_b, observed});
+      map, base, L.triangularView<Eigen::Lower>().solve(Eigen::MatrixXd::Identity(k, k)), theta_b,
+      observed});
   data->AddParameterBlock(P);
   data->SetNumResiduals(static_cast<int>(k));
   problem.AddResidualBlock(data, nullptr, phi.data());
