@@ -53,8 +53,11 @@ TEST(IdentifyCli, ModelBaseWritesBaseParametersAndUnidentifiable) {
 // A planar2 run generated here from the closed form of docs/methods/model.md (not by dynid), with
 // Coulomb friction fc·sign(dq) added to each joint's torque.
 std::string planar2_run(double fc = 0.0) {
-  const std::string path =
-      ::testing::TempDir() + (fc == 0.0 ? "/planar2_run.csv" : "/planar2_run_coulomb.csv");
+  // One file per test process: ctest runs the tests of this file in parallel, and a file one test
+  // rewrites while another reads it would be a race.
+  const std::string path = ::testing::TempDir() +
+                           (fc == 0.0 ? "/planar2_run." : "/planar2_run_coulomb.") +
+                           std::to_string(::getpid()) + ".csv";
   std::ofstream f(path);
   f << "t,q1,q2,dq1,dq2,ddq1,ddq2,tau1,tau2\n";
   const double m1 = 2.0, m2 = 1.5, l1 = 1.0, c1 = 0.5, c2 = 0.4, I1 = 2.0 / 12,
@@ -292,7 +295,8 @@ namespace {
 // planar2 with joint 2 held at q2 = 0.5 rad (its torque from the same closed form, see
 // planar2_run): joint 2's inertia about its own axis and its friction are not excited.
 std::string planar2_joint2_still() {
-  const std::string path = ::testing::TempDir() + "/planar2_joint2_still.csv";
+  const std::string path =
+      ::testing::TempDir() + "/planar2_joint2_still." + std::to_string(::getpid()) + ".csv";
   std::ofstream f(path);
   f << "t,q1,q2,dq1,dq2,ddq1,ddq2,tau1,tau2\n";
   const double m1 = 2.0, m2 = 1.5, l1 = 1.0, c1 = 0.5, c2 = 0.4, I1 = 2.0 / 12,
