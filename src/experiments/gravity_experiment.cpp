@@ -303,6 +303,15 @@ BaseParameters gravity_row_base(const Model& model, int joint) {
 
 }  // namespace
 
+struct JointGravityModel::Row {
+  Row(const Model& m, int joint) : model(m), gravity_row(model, joint) {}
+  Row(const Row&) = delete;  // gravity_row refers to this object's model
+  Row& operator=(const Row&) = delete;
+  Model model;              // owned: gravity_row refers to it
+  GravityRow gravity_row;   // workspace reused by every torque() call
+  Eigen::VectorXd weights;  // per link column [docs/design.md §3 order]
+};
+
 JointGravityModel JointGravityModel::sinusoid(int joint, double k, double q_off) {
   if (!std::isfinite(k) || !std::isfinite(q_off)) {
     throw Error("the gravity of joint " + std::to_string(joint + 1) +
@@ -331,18 +340,17 @@ JointGravityModel JointGravityModel::poses(const Model& model, int joint,
   }
   JointGravityModel g;
   g.joint_ = joint;
-  g.model_ = std::make_shared<const Model>(model);
+  g.row_ = std::make_shared<Row>(model, joint);
   const auto columns = static_cast<Eigen::Index>(kLinkParams * model.dof());
-  // base.select() maps rows over the link columns to the base columns (base + K_d·dependent).
-  g.select_ = base.select(Eigen::MatrixXd::Identity(columns, columns));
-  g.theta_ = values;
+  // base.select() maps rows over the link columns to the base columns (base + K_d·dependent), so
+  // τ_g,J = Y_g,J(q)·select(I)·θ_g: one weight per link column, formed once.
+  g.row_->weights = base.select(Eigen::MatrixXd::Identity(columns, columns)) * values;
   return g;
 }
 
 double JointGravityModel::torque(const Eigen::VectorXd& q) const {
-  if (!model_) return k_ * std::sin(q[joint_] + q_off_);
-  GravityRow row(*model_, joint_);
-  return (row(q) * select_ * theta_)(0);
+  if (!row_) return k_ * std::sin(q[joint_] + q_off_);
+  return row_->gravity_row(q).dot(row_->weights);
 }
 
 GravityPosesResult fit_gravity_poses(const Model& model, const std::vector<ProcessedRecord>& runs,

@@ -192,6 +192,35 @@ TEST(GravityPoses, ShoulderGravityFromSlopesAtThreeElbowPoses) {
   EXPECT_EQ(r.slope_names.size(), 2 * elbow.size());
 }
 
+// The gravity a poses result stands for, as `identify --model friction --params gravity.json`
+// compensates it (issue 25 item 7): with the true values of the fitted base parameters (from
+// their expressions), JointGravityModel::poses() gives RNEA's gravity torque of the shoulder at
+// poses the fit never saw; names of another joint are an error.
+TEST(GravityPoses, PosesModelPredictsTheGravityTorqueAtAnyPose) {
+  const Model m = plant_model();
+  std::vector<ProcessedRecord> runs;
+  for (const double elbow : {-0.6, 0.3, 1.0})
+    runs.push_back(prepared(m, slopes(0, {0.0, elbow}, 0.6), 31));
+  const GravityPosesResult r = fit_gravity_poses(m, runs, 0);
+  std::map<std::string, double> theta;
+  const std::vector<std::string> names = ParameterLayout::rigid().names(m.dof());
+  const Eigen::VectorXd values = ParameterLayout::rigid().parameters(m);
+  for (size_t i = 0; i < names.size(); ++i) theta[names[i]] = values[static_cast<Eigen::Index>(i)];
+  Eigen::VectorXd truth(static_cast<Eigen::Index>(r.names.size()));
+  for (size_t i = 0; i < r.names.size(); ++i)
+    truth[static_cast<Eigen::Index>(i)] = expression_value(r.expressions[i], theta);
+  const JointGravityModel g = JointGravityModel::poses(m, 0, r.names, truth);
+  RneaOptions gravity_only;
+  gravity_only.joint_terms = false;
+  const Eigen::Vector2d zero(0.0, 0.0);
+  for (const auto& q :
+       {Eigen::Vector2d(0.4, -1.3), Eigen::Vector2d(-2.0, 2.5), Eigen::Vector2d(1.1, 0.2)}) {
+    const double expected = rnea(m, q, zero, zero, gravity_only)[0];
+    EXPECT_NEAR(g.torque(q), expected, 1e-9 * std::max(1.0, std::abs(expected))) << q.transpose();
+  }
+  EXPECT_THROW(JointGravityModel::poses(m, 1, r.names, truth), Error);
+}
+
 TEST(GravityPoses, OnePoseOfTheOtherJointsIsRefusedNamingWhatIsMissing) {
   const Model m = plant_model();
   const std::vector<ProcessedRecord> runs = {prepared(m, slopes(0, {0.0, 0.3}, 0.6), 21),

@@ -131,15 +131,15 @@ class JointGravityModel {
                                  const std::vector<std::string>& names,
                                  const Eigen::VectorXd& values);
   int joint() const { return joint_; }  ///< 0-based joint index J
-  /// τ_g,J at the positions q (n values) [N·m or N].
+  /// τ_g,J at the positions q (n values) [N·m or N]. The poses form reuses one regressor workspace
+  /// (no allocation per call), so one model must not be evaluated from several threads at once.
   double torque(const Eigen::VectorXd& q) const;
 
  private:
+  struct Row;  // the gravity row's workspace and its weights over the link columns (poses form)
   int joint_ = 0;
   double k_ = 0.0, q_off_ = 0.0;
-  std::shared_ptr<const Model> model_;  // set for the poses form only
-  Eigen::MatrixXd select_;              // link columns × base parameters of the gravity row
-  Eigen::VectorXd theta_;
+  std::shared_ptr<Row> row_;
 };
 
 }  // namespace dynid
