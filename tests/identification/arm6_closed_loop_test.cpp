@@ -16,6 +16,8 @@
 #include <filesystem>
 #include <string>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include "dynid/identification/identify.hpp"
@@ -38,7 +40,10 @@ constexpr double kIndependentError = 0.0091;
 
 // The run decompressed into the test's scratch folder (dynid reads plain CSV).
 std::string unpacked(const std::string& name) {
-  const fs::path out = fs::path(::testing::TempDir()) / ("arm6_" + name);
+  // One copy per test process: ctest runs the cases in parallel, and a copy another process is
+  // still writing would be read half-written (or make the case skip).
+  const fs::path out =
+      fs::path(::testing::TempDir()) / ("arm6_" + std::to_string(::getpid()) + "_" + name);
   const std::string command = "gzip -dc '" + kDir + "/" + name + ".gz' > '" + out.string() + "'";
   if (std::system(command.c_str()) != 0) return "";
   return out.string();
