@@ -33,7 +33,7 @@ ParameterLayout viscous_layout() {
   return l;
 }
 
-Model plant_model() {
+Model ml_plant_model() {
   Model m = load_robot("planar2");
   m.joints[0].friction.Fv = 1.5;
   m.joints[0].friction.Ia = 0.05;
@@ -43,7 +43,7 @@ Model plant_model() {
 }
 
 TEST(MaximumLikelihood, SensitivityMatchesMassMatrixAndRneaDifferences) {
-  const Model m = plant_model();
+  const Model m = ml_plant_model();
   const ParameterLayout layout = viscous_layout();
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(-1.5, 1.5);
@@ -95,7 +95,7 @@ TEST(MaximumLikelihood, SensitivityMatchesMassMatrixAndRneaDifferences) {
 // A slice of a processed record regresses as the same rows of the whole record (row k of W
 // depends on sample k only), Coulomb indicator columns included; a range outside is an error.
 TEST(ProcessedSlice, RegressesAsTheSameRowsOfTheWholeRecord) {
-  const Model m = plant_model();
+  const Model m = ml_plant_model();
   ParameterLayout layout = viscous_layout();
   layout.coulomb = true;
   std::mt19937_64 rng(3);
@@ -124,7 +124,7 @@ struct MeasuredRun {
   Eigen::VectorXd truth;
 };
 
-constexpr double kRate = 100.0;
+constexpr double kMlRate = 100.0;
 
 // A closed-loop run of the plant without sensor noise; the true q, q̇, q̈, τ are then measured with
 // independent white noise of the given sizes. averaged > 0: that many periods are measured and
@@ -133,7 +133,7 @@ constexpr double kRate = 100.0;
 MeasuredRun measured_run(const Model& m, const MeasurementNoise& noise, unsigned seed,
                          int averaged = 0) {
   const TrajectorySamples tr =
-      sample_trajectory(FourierTrajectory(testing::planar2_reference()), kRate, false);
+      sample_trajectory(FourierTrajectory(testing::planar2_reference()), kMlRate, false);
   SimulateOptions so;
   so.loop.periods = averaged > 0 ? averaged + 1 : 3;
   so.loop.record_truth = true;
@@ -159,7 +159,7 @@ MeasuredRun measured_run(const Model& m, const MeasurementNoise& noise, unsigned
     Eigen::MatrixXd x(rows, 4 * n2);
     x << rec.q, rec.dq, rec.ddq, rec.tau;
     const TimedPeriodAverage a =
-        average_periods_in_time(rec.t, x, static_cast<double>(tr.t.size()) / kRate);
+        average_periods_in_time(rec.t, x, static_cast<double>(tr.t.size()) / kMlRate);
     EXPECT_EQ(a.periods, averaged);
     EXPECT_FALSE(a.interpolated);
     rec.t = a.phase;
@@ -200,7 +200,7 @@ MeasurementNoise noise_of_size(double scale) {
 }
 
 TEST(MaximumLikelihood, NoiseFreeRunGivesTheTruthFromAPerturbedStart) {
-  const Model m = plant_model();
+  const Model m = ml_plant_model();
   const MeasuredRun run = measured_run(m, noise_of_size(0.0), 1);
   const Eigen::VectorXd start = 1.1 * run.truth;
   MaximumLikelihoodSummary summary;
@@ -230,7 +230,7 @@ TEST(MaximumLikelihood, NoiseFreeRunGivesTheTruthFromAPerturbedStart) {
 // differences of the residual itself, away from the optimum (so that ∂S/∂θ matters) and with
 // noise large enough that S_k is far from diagonal.
 TEST(MaximumLikelihood, AnalyticJacobianMatchesCentralDifferences) {
-  const Model m = plant_model();
+  const Model m = ml_plant_model();
   const MeasurementNoise noise = noise_of_size(1.0);
   const MeasuredRun run = measured_run(m, noise, 5);
   const Eigen::VectorXd theta = 1.2 * run.truth + Eigen::VectorXd::Constant(run.truth.size(), 0.05);
@@ -263,7 +263,7 @@ TEST(MaximumLikelihood, AnalyticJacobianMatchesCentralDifferences) {
 // Over seeds: the OLS estimate of the noisy regressor is attenuated (errors in variables, seed 1
 // eqs. 39–45), the ML one is not, and its intervals hold the truth.
 TEST(MaximumLikelihood, ErrorsInVariablesBiasOlsButNotMaximumLikelihood) {
-  const Model m = plant_model();
+  const Model m = ml_plant_model();
   // Half the noise_of_size(1) levels: σ_q̈ = 0.75 rad/s² on q̈ of a few rad/s². At twice this the
   // noise is no longer small against the regressor's curvature (q̇² and sin q terms: eq. 16's
   // linearisation) and 12 of 72 truths fall outside the 99.9 % intervals
@@ -307,7 +307,7 @@ TEST(MaximumLikelihood, ErrorsInVariablesBiasOlsButNotMaximumLikelihood) {
 // only the variance factor, reported as "about 1 when the noise is right", differs: ≈ 1/K with
 // the raw σ, ≈ 1 with the mean's.
 TEST(MaximumLikelihood, AveragedPeriodsNeedTheNoiseOfTheMeanOnlyForTheVarianceFactor) {
-  const Model m = plant_model();
+  const Model m = ml_plant_model();
   constexpr int kPeriods = 4, kSeeds = 5;
   const MeasurementNoise raw = noise_of_size(1.0);
   MeasurementNoise mean = raw;
@@ -345,7 +345,7 @@ TEST(MaximumLikelihood, AveragedPeriodsNeedTheNoiseOfTheMeanOnlyForTheVarianceFa
 }
 
 TEST(MaximumLikelihood, BadNoiseIsRefused) {
-  const Model m = plant_model();
+  const Model m = ml_plant_model();
   const MeasuredRun run = measured_run(m, noise_of_size(0.0), 1);
   MeasurementNoise zero = noise_of_size(1.0);
   zero.tau.setZero();

@@ -17,12 +17,14 @@
 #include "dynid/model/robots.hpp"
 #include "dynid/sim/simulate_reference.hpp"
 #include "support/closed_loop_runs.hpp"
+#include "support/test_constants.hpp"
 
 namespace dynid {
 namespace {
 
+using test_support::kPi;
+
 constexpr double kRate = 200.0;
-constexpr double kPi = 3.14159265358979323846;
 
 Model plant_model() {
   Model m = load_robot("planar2");

@@ -26,9 +26,9 @@
 namespace dynid {
 namespace {
 
-constexpr double kRate = 200.0;
+constexpr double kFrictionRate = 200.0;
 
-Model plant_model() {
+Model friction_plant_model() {
   Model m = load_robot("planar2");
   m.joints[0].friction = {0.0, 1.5, 2.0, 0.4};
   m.joints[1].friction = {0.0, 0.8, 1.0, -0.2};
@@ -41,10 +41,10 @@ ProcessedRecord bang_bang_run(const Model& m, int joint, unsigned seed) {
   wp(joint, 0) = -1.0;
   wp(joint, 1) = 1.0;
   wp(joint, 2) = -1.0;
-  const TrajectorySamples tr =
-      sample_trajectory(BangBangTrajectory(wp, Eigen::Vector2d::Constant(4.0), 0.2), kRate, false);
+  const TrajectorySamples tr = sample_trajectory(
+      BangBangTrajectory(wp, Eigen::Vector2d::Constant(4.0), 0.2), kFrictionRate, false);
   return testing::prepared(
-      testing::closed_loop_run(m, tr, testing::noisy_sensors(1e-4, 0.05, seed, 4)), kRate);
+      testing::closed_loop_run(m, tr, testing::noisy_sensors(1e-4, 0.05, seed, 4)), kFrictionRate);
 }
 
 Eigen::Vector4d truth(const JointFriction& f) {
@@ -52,7 +52,7 @@ Eigen::Vector4d truth(const JointFriction& f) {
 }
 
 TEST(FrictionExperiment, RecoversAsymmetricFrictionInsideItsIntervals) {
-  const Model m = plant_model();
+  const Model m = friction_plant_model();
   for (int joint : {0, 1}) {
     for (unsigned seed : {1u, 2u}) {
       SCOPED_TRACE("joint " + std::to_string(joint + 1) + ", seed " + std::to_string(seed));
@@ -78,7 +78,7 @@ TEST(FrictionExperiment, AWrongCompensationModelShowsInTheFriction) {
   // Negative control: compensating with link masses 30 % high leaves gravity and inertia torque in
   // τ_f. The estimates are then far off, and the result must say so: a large relative error, a
   // warning, and HAC intervals much wider than the white ones (the residual is not noise).
-  const Model m = plant_model();
+  const Model m = friction_plant_model();
   Model wrong = m;
   for (auto& link : wrong.links) link *= 1.3;
   const FrictionExperimentResult r = fit_friction_experiment(wrong, {bang_bang_run(m, 0, 1)}, 0);
@@ -93,7 +93,7 @@ TEST(FrictionExperiment, AWrongCompensationModelShowsInTheFriction) {
 }
 
 TEST(FrictionExperiment, OneDirectionOnlyIsRefused) {
-  const Model m = plant_model();
+  const Model m = friction_plant_model();
   const ProcessedRecord full = bang_bang_run(m, 1, 1);
   std::vector<Eigen::Index> up;
   for (Eigen::Index k = 0; k < full.record.t.size(); ++k)
@@ -123,7 +123,7 @@ TEST(FrictionExperiment, OneDirectionOnlyIsRefused) {
 // Issue 14 item 10: a bang-bang run cut so that it only speeds up (both directions, every speed,
 // but no braking) must be refused: the compensated inertia's error would be fitted as Coulomb.
 TEST(FrictionExperiment, ARunThatNeverDeceleratesIsRefused) {
-  const Model m = plant_model();
+  const Model m = friction_plant_model();
   const ProcessedRecord full = bang_bang_run(m, 0, 3);
   std::vector<Eigen::Index> speeding;
   for (Eigen::Index k = 0; k < full.record.t.size(); ++k)
@@ -196,14 +196,14 @@ namespace {
 // subtraction (negative control) the friction torque is fitted by the inertial columns.
 TEST(KnownFriction, SubtractedFrictionLeavesRigidBodyInsideIntervals) {
   const Model plant = testing::planar2_with_friction();
-  constexpr double kRate = 200.0;
+  constexpr double kFrictionRate = 200.0;
   const TrajectorySamples tr =
-      sample_trajectory(FourierTrajectory(testing::planar2_reference()), kRate, false);
+      sample_trajectory(FourierTrajectory(testing::planar2_reference()), kFrictionRate, false);
   const JointRecord run =
       testing::closed_loop_run(plant, tr, testing::noisy_sensors(1e-5, 0.05, 3, 6));
   IdentifyOptions io;
   io.layout = ParameterLayout::rigid();
-  io.signal.torque_time_offset = 0.5 / kRate;
+  io.signal.torque_time_offset = 0.5 / kFrictionRate;
   std::vector<std::string> names;
   std::vector<double> values;
   for (int j = 0; j < 2; ++j) {

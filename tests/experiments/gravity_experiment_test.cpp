@@ -20,14 +20,16 @@
 #include "dynid/regressor/parameter_layout.hpp"
 #include "dynid/sim/simulate_reference.hpp"
 #include "support/closed_loop_runs.hpp"
+#include "support/test_constants.hpp"
 
 namespace dynid {
 namespace {
 
-constexpr double kRate = 200.0;
-constexpr double kPi = 3.14159265358979323846;
+using test_support::kPi;
 
-Model plant_model() {
+constexpr double kGravityRate = 200.0;
+
+Model gravity_plant_model() {
   Model m = load_robot("planar2");
   m.joints[0].friction.Fv = 1.5;
   m.joints[0].friction.Fc = 2.0;
@@ -66,7 +68,7 @@ std::pair<double, double> same_side(double k, double q_off, double q_off_truth) 
 
 ProcessedRecord prepared(const Model& m, const TrajectorySamples& tr, unsigned seed) {
   return testing::prepared(
-      testing::closed_loop_run(m, tr, testing::noisy_sensors(1e-4, 0.05, seed, 3)), kRate);
+      testing::closed_loop_run(m, tr, testing::noisy_sensors(1e-4, 0.05, seed, 3)), kGravityRate);
 }
 
 TrajectorySamples slopes(int joint, const Eigen::Vector2d& pose, double velocity) {
@@ -75,11 +77,11 @@ TrajectorySamples slopes(int joint, const Eigen::Vector2d& pose, double velocity
   to[joint] = 1.2;
   const SlopeTrajectory tr(from, to, Eigen::Vector2d::Constant(velocity),
                            Eigen::Vector2d::Constant(2.0), 1, 0.5);
-  return sample_trajectory(tr, kRate, false);
+  return sample_trajectory(tr, kGravityRate, false);
 }
 
 TEST(GravityExperiment, RecoversTheGravityOfEachJointInsideItsInterval) {
-  const Model m = plant_model();
+  const Model m = gravity_plant_model();
   const Eigen::Vector2d pose(0.3, 0.6);
   for (int joint : {0, 1}) {
     for (unsigned seed : {1u, 2u}) {
@@ -109,7 +111,7 @@ TEST(GravityExperiment, RecoversTheGravityOfEachJointInsideItsInterval) {
 TEST(GravityExperiment, TwoRunsOneDirectionEach) {
   // The form: --data up.csv --data down.csv. Each run here has both directions; the fit
   // uses every slope it finds and keeps one offset per (run, direction).
-  const Model m = plant_model();
+  const Model m = gravity_plant_model();
   const Eigen::Vector2d pose(0.0, -0.4);
   const GravityExperimentResult r = fit_gravity_experiment(
       {prepared(m, slopes(1, pose, 0.4), 3), prepared(m, slopes(1, pose, 0.8), 4)}, 1);
@@ -121,11 +123,11 @@ TEST(GravityExperiment, TwoRunsOneDirectionEach) {
 }
 
 TEST(GravityExperiment, ARunWithoutConstantVelocityIsRefused) {
-  const Model m = plant_model();
+  const Model m = gravity_plant_model();
   FourierCoefficients c = FourierCoefficients::zeros({3, 3}, 0.2);
   c.a[0] << 0.8, 0.3, -0.2;
   c.b[1] << 0.2, -0.1, 0.1;
-  const TrajectorySamples tr = sample_trajectory(FourierTrajectory(c), kRate, false);
+  const TrajectorySamples tr = sample_trajectory(FourierTrajectory(c), kGravityRate, false);
   try {
     fit_gravity_experiment({prepared(m, tr, 1)}, 0);
     FAIL() << "a Fourier run was accepted as slopes";
@@ -160,7 +162,7 @@ double expression_value(const std::string& expression, const std::map<std::strin
 // first moments of both links, the elbow's mass regrouped into the shoulder's), so slopes at one
 // elbow pose give k and q_off only; three elbow poses determine all four.
 TEST(GravityPoses, ShoulderGravityFromSlopesAtThreeElbowPoses) {
-  const Model m = plant_model();
+  const Model m = gravity_plant_model();
   const std::vector<double> elbow = {-0.6, 0.3, 1.0};
   std::vector<ProcessedRecord> runs;
   for (size_t i = 0; i < elbow.size(); ++i)
@@ -197,7 +199,7 @@ TEST(GravityPoses, ShoulderGravityFromSlopesAtThreeElbowPoses) {
 // their expressions), JointGravityModel::poses() gives RNEA's gravity torque of the shoulder at
 // poses the fit never saw; names of another joint are an error.
 TEST(GravityPoses, PosesModelPredictsTheGravityTorqueAtAnyPose) {
-  const Model m = plant_model();
+  const Model m = gravity_plant_model();
   std::vector<ProcessedRecord> runs;
   for (const double elbow : {-0.6, 0.3, 1.0})
     runs.push_back(prepared(m, slopes(0, {0.0, elbow}, 0.6), 31));
@@ -222,7 +224,7 @@ TEST(GravityPoses, PosesModelPredictsTheGravityTorqueAtAnyPose) {
 }
 
 TEST(GravityPoses, OnePoseOfTheOtherJointsIsRefusedNamingWhatIsMissing) {
-  const Model m = plant_model();
+  const Model m = gravity_plant_model();
   const std::vector<ProcessedRecord> runs = {prepared(m, slopes(0, {0.0, 0.3}, 0.6), 21),
                                              prepared(m, slopes(0, {0.0, 0.3}, 0.4), 22)};
   try {

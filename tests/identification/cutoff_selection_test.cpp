@@ -26,7 +26,7 @@
 namespace dynid {
 namespace {
 
-Model plant_model() {
+Model cutoff_plant_model() {
   return testing::planar2_with_friction();
 }
 
@@ -100,14 +100,14 @@ IdentifyOptions held_torque(double rate) {
 const std::vector<double> kGrid100 = {1, 1.5, 2, 3, 5, 7, 10};
 
 TEST(CutoffSelection, LowNoiseClosedLoopWithinTwentyPercentOfTheBestFixedCutoff) {
-  const Model m = plant_model();
+  const Model m = cutoff_plant_model();
   const Sweep s = sweep(m, closed_loop_run(m, false, 1e-5, 1), closed_loop_run(m, true, 1e-5, 11),
                         held_torque(100.0), kGrid100);
   EXPECT_LE(s.auto_error, 1.2 * s.best_error) << s.table;
 }
 
 TEST(CutoffSelection, NoisyClosedLoopWithinTwentyPercentOfTheBestFixedCutoff) {
-  const Model m = plant_model();
+  const Model m = cutoff_plant_model();
   const Sweep s = sweep(m, closed_loop_run(m, false, 1e-3, 1), closed_loop_run(m, true, 1e-3, 11),
                         held_torque(100.0), kGrid100);
   EXPECT_LE(s.auto_error, 1.2 * s.best_error) << s.table;

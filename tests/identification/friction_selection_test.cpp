@@ -21,17 +21,17 @@
 namespace dynid {
 namespace {
 
-constexpr double kRate = 100.0;  // a cobot-like log rate
-constexpr double kNoise = 1e-5;  // encoder noise [rad] (≈ a 2^19-count encoder), fed back
+constexpr double kCobotRate = 100.0;  // a cobot-like log rate
+constexpr double kNoise = 1e-5;       // encoder noise [rad] (≈ a 2^19-count encoder), fed back
 
-Model plant_model() {
+Model cobot_plant_model() {
   return testing::planar2_with_friction();
 }
 
 // Six periods of a 0.2 Hz, 4-harmonic reference; the first (start-up) period is dropped.
 JointRecord closed_loop_run(const Model& m, unsigned seed) {
   const TrajectorySamples tr =
-      sample_trajectory(FourierTrajectory(testing::planar2_reference()), kRate, false);
+      sample_trajectory(FourierTrajectory(testing::planar2_reference()), kCobotRate, false);
   return testing::closed_loop_run(m, tr, testing::noisy_sensors(kNoise, 0.05, seed, 6));
 }
 
@@ -63,16 +63,16 @@ FrictionCheck check(const Model& m, const IdentificationResult& r, bool white = 
 
 IdentifyOptions held_torque() {
   IdentifyOptions o;
-  o.signal.torque_time_offset = 0.5 / kRate;  // the logged command is held over the next step
+  o.signal.torque_time_offset = 0.5 / kCobotRate;  // the logged command is held over the next step
   return o;
 }
 
 TEST(FrictionSelection, FormerThresholdIsBiasedAndTheDefaultIsNot) {
-  const Model m = plant_model();
+  const Model m = cobot_plant_model();
   for (unsigned seed : {1u, 2u}) {
     const JointRecord run = closed_loop_run(m, seed);
     IdentifyOptions old = held_torque();
-    old.signal.cutoff_hz = std::min(20.0, kRate / 10.0);
+    old.signal.cutoff_hz = std::min(20.0, kCobotRate / 10.0);
     {
       std::vector<std::pair<std::string, std::string>> choices;
       IdentifyOptions all = old;

@@ -15,11 +15,12 @@
 #include "dynid/model/robots.hpp"
 #include "dynid/model/transmission.hpp"
 #include "identification/integral_support.hpp"
+#include "support/test_constants.hpp"
 
 namespace dynid {
 namespace {
 
-const std::string kData = std::string(DYNID_SOURCE_DIR) + "/examples/staubli-tx40/dataset";
+using test_support::kTx40DataDir;
 
 struct Tx40Integral {
   Model model;
@@ -95,7 +96,7 @@ double value(const Tx40Integral& r, const std::string& name) {
 // pins these numbers so that a change to the builder or the defaults that moves them is seen.
 TEST(IntegralTx40, FrictionAgainstPublishedValues) {
   const Tx40Integral* r = data();
-  if (r == nullptr) GTEST_SKIP() << "data set not found at " << kData;
+  if (r == nullptr) GTEST_SKIP() << "data set not found at " << kTx40DataDir;
   int within = 0;
   for (int j = 0; j < 6; ++j) {
     const std::string k = std::to_string(j + 1);
@@ -145,7 +146,7 @@ TEST(IntegralTx40, FrictionAgainstPublishedValues) {
 // the weakly determined directions of one scalar equation per interval absorb.
 TEST(IntegralTx40, RecoversTheFrictionOfTorquesARigidModelExplains) {
   const Tx40Integral* r = data();
-  if (r == nullptr) GTEST_SKIP() << "data set not found at " << kData;
+  if (r == nullptr) GTEST_SKIP() << "data set not found at " << kTx40DataDir;
   ASSERT_EQ(r->differential_missing, 0);
   std::cout << "energy equations on rigid-model torques: relative error "
             << r->rigid_estimate.relative_error << "\n";
@@ -167,7 +168,7 @@ TEST(IntegralTx40, RecoversTheFrictionOfTorquesARigidModelExplains) {
 
 TEST(IntegralTx40, TorqueValidationBesideTheDifferentialModel) {
   const Tx40Integral* r = data();
-  if (r == nullptr) GTEST_SKIP() << "data set not found at " << kData;
+  if (r == nullptr) GTEST_SKIP() << "data set not found at " << kTx40DataDir;
   std::cout << "torque validation on the run (differential processing): integral model "
             << r->integral_validation.relative_error_all << ", differential model "
             << r->differential_validation.relative_error_all << "\n";

@@ -15,16 +15,18 @@
 #include "dynid/io/csv_reader.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/model/transmission.hpp"
+#include "support/test_constants.hpp"
 
 namespace dynid {
 namespace {
 
+using test_support::kTx40DataDir;
+
 // The copy shipped in the repository (examples/staubli-tx40/dataset).
-const std::string kData = std::string(DYNID_SOURCE_DIR) + "/examples/staubli-tx40/dataset";
 
 // FIGAROH's OLS value of each base parameter, keyed by the first token of its expression.
 std::map<std::string, double> figaroh_ols() {
-  std::ifstream f(kData + "/results/TX40_bp_5.csv");
+  std::ifstream f(kTx40DataDir + "/results/TX40_bp_5.csv");
   std::map<std::string, double> out;
   std::string line;
   while (std::getline(f, line)) {
@@ -40,14 +42,14 @@ std::map<std::string, double> figaroh_ols() {
 class Tx40Dataset : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    if (!std::filesystem::exists(kData + "/data/pos_read_data.csv")) return;
+    if (!std::filesystem::exists(kTx40DataDir + "/data/pos_read_data.csv")) return;
     const Model model =
         load_robot(std::string(DYNID_SOURCE_DIR) + "/examples/staubli-tx40/tx40.yaml");
-    const CsvTable pos = read_csv(kData + "/data/pos_read_data.csv");
-    const CsvTable cur = read_csv(kData + "/data/curr_data.csv");
+    const CsvTable pos = read_csv(kTx40DataDir + "/data/pos_read_data.csv");
+    const CsvTable cur = read_csv(kTx40DataDir + "/data/curr_data.csv");
     JointRecord r;
     const double ts =
-        YAML::LoadFile(kData +
+        YAML::LoadFile(kTx40DataDir +
                        "/config/T40X_config.yaml")["identification"]["processing_params"][0]["ts"]
             .as<double>();
     r.t = Eigen::VectorXd::LinSpaced(pos.rows(), 0.0, (pos.rows() - 1) * ts);
@@ -62,7 +64,7 @@ class Tx40Dataset : public ::testing::Test {
     delete validation_;
   }
   void SetUp() override {
-    if (result_ == nullptr) GTEST_SKIP() << "data set not found at " << kData;
+    if (result_ == nullptr) GTEST_SKIP() << "data set not found at " << kTx40DataDir;
   }
   static double value(const std::string& name) {
     const auto& names = result_->names;
@@ -103,8 +105,8 @@ TEST_F(Tx40Dataset, ValidationOnTheSameRunReproducesTheIdentificationError) {
 }
 
 TEST_F(Tx40Dataset, FrictionMatchesPublishedValues) {
-  const YAML::Node p =
-      YAML::LoadFile(kData + "/config/T40X_config.yaml")["identification"]["robot_params"][0];
+  const YAML::Node p = YAML::LoadFile(
+      kTx40DataDir + "/config/T40X_config.yaml")["identification"]["robot_params"][0];
   for (int j = 0; j < 6; ++j) {
     const std::string k = std::to_string(j + 1);
     const double fv = p["fv"][j].as<double>(), fs = p["fs"][j].as<double>();

@@ -8,11 +8,12 @@
 #include <Eigen/Geometry>
 
 #include "dynid/common/error.hpp"
+#include "support/test_constants.hpp"
 
 namespace dynid {
 namespace {
 
-const std::string kData = std::string(DYNID_SOURCE_DIR) + "/tests/data/models/";
+using test_support::kModelsDir;
 
 using dynid::testing::error_of;
 
@@ -182,7 +183,7 @@ TEST(MdhLoader, Transmissions) {
 }
 
 TEST(MdhLoader, UrdfWrapperAppliesOverrides) {
-  const Model model = load_yaml_model(kData + "wrapper.yaml");
+  const Model model = load_yaml_model(kModelsDir + "wrapper.yaml");
   ASSERT_EQ(model.dof(), 2);
   EXPECT_EQ(model.name, "wrapped");
   EXPECT_TRUE(model.gravity.isApprox(Eigen::Vector3d(0, -9.81, 0)));
@@ -271,19 +272,19 @@ TEST(MdhLoaderErrors, SizeLimits) {
 }
 
 TEST(MdhLoaderErrors, WrongTransmissionSize) {
-  const std::string msg = error_of([] { load_yaml_model(kData + "bad_transmission.yaml"); });
+  const std::string msg = error_of([] { load_yaml_model(kModelsDir + "bad_transmission.yaml"); });
   EXPECT_NE(msg.find("transmission.N"), std::string::npos) << msg;
   EXPECT_NE(msg.find("must be a 2x2 matrix"), std::string::npos) << msg;
 }
 
 TEST(MdhLoaderErrors, MissingKeyNamesKeyAndRow) {
-  const std::string msg = error_of([] { load_yaml_model(kData + "missing_key.yaml"); });
+  const std::string msg = error_of([] { load_yaml_model(kModelsDir + "missing_key.yaml"); });
   EXPECT_NE(msg.find("joints[2] ('b')"), std::string::npos) << msg;
   EXPECT_NE(msg.find("missing key 'alpha'"), std::string::npos) << msg;
 }
 
 TEST(MdhLoaderErrors, NanValue) {
-  const std::string msg = error_of([] { load_yaml_model(kData + "nan_value.yaml"); });
+  const std::string msg = error_of([] { load_yaml_model(kModelsDir + "nan_value.yaml"); });
   EXPECT_NE(msg.find("joints[1] ('a').d"), std::string::npos) << msg;
   EXPECT_NE(msg.find("give a finite value"), std::string::npos) << msg;
 }
@@ -303,11 +304,12 @@ TEST(MdhLoaderErrors, UnknownKeyNegativeMassBadYamlAndUnknownJoint) {
   msg = error_of([] { parse_yaml_model("joints: [ {sigma: 0", "t.yaml", "."); });
   EXPECT_NE(msg.find("robot file 't.yaml', line 1, column "), std::string::npos) << msg;
   EXPECT_NE(msg.find(": not valid YAML ("), std::string::npos) << msg;
-  msg = error_of(
-      [] { parse_yaml_model("urdf: two_link.urdf\nfriction: {j9: {Fv: 1}}\n", "w.yaml", kData); });
+  msg = error_of([] {
+    parse_yaml_model("urdf: two_link.urdf\nfriction: {j9: {Fv: 1}}\n", "w.yaml", kModelsDir);
+  });
   EXPECT_NE(msg.find("friction.j9: no joint of that name; joints are j1, j2"), std::string::npos)
       << msg;
-  msg = error_of([] { parse_yaml_model("urdf: missing.urdf\n", "w.yaml", kData); });
+  msg = error_of([] { parse_yaml_model("urdf: missing.urdf\n", "w.yaml", kModelsDir); });
   EXPECT_NE(msg.find("cannot open robot file"), std::string::npos) << msg;
   msg = error_of([] {
     parse_yaml_model("joints:\n  - {sigma: 2, alpha: 0, d: 0, theta: 0, r: 0}\n", "t.yaml", ".");

@@ -10,11 +10,12 @@
 #include <gtest/gtest.h>
 
 #include "dynid/common/error.hpp"
+#include "support/test_constants.hpp"
 
 namespace dynid {
 namespace {
 
-const std::string kData = std::string(DYNID_SOURCE_DIR) + "/tests/data/models/";
+using test_support::kModelsDir;
 
 using dynid::testing::error_of;
 
@@ -61,7 +62,7 @@ TEST(Robots, PathsAndSourcesAndEnvironmentOverride) {
   EXPECT_EQ(m.source, path);
   EXPECT_EQ(load_robot("planar2").source, path);
 
-  ASSERT_EQ(setenv("DYNID_ROBOTS_DIR", (kData + "robots_dir").c_str(), 1), 0);
+  ASSERT_EQ(setenv("DYNID_ROBOTS_DIR", (kModelsDir + "robots_dir").c_str(), 1), 0);
   EXPECT_EQ(builtin_robot_names(), std::vector<std::string>{"tiny"});
   EXPECT_EQ(load_robot("tiny").dof(), 2);
   const std::string msg = error_of([] { load_robot("puma560"); });
@@ -80,8 +81,9 @@ TEST(RobotsErrors, UnknownBuiltinListsNames) {
 TEST(RobotsErrors, UnsupportedExtensionAndMissingFile) {
   std::string msg = error_of([] { load_robot("robot.sdf"); });
   EXPECT_NE(msg.find("extension '.sdf'"), std::string::npos) << msg;
-  msg = error_of([] { load_robot(kData + "nope.yaml"); });
-  EXPECT_NE(msg.find("cannot open robot file '" + kData + "nope.yaml'"), std::string::npos) << msg;
+  msg = error_of([] { load_robot(kModelsDir + "nope.yaml"); });
+  EXPECT_NE(msg.find("cannot open robot file '" + kModelsDir + "nope.yaml'"), std::string::npos)
+      << msg;
 }
 
 // planar2: the link parameters are the closed-form ones stated in docs/methods/model.md.

@@ -12,11 +12,12 @@
 #include <Eigen/Geometry>
 
 #include "dynid/common/error.hpp"
+#include "support/test_constants.hpp"
 
 namespace dynid {
 namespace {
 
-const std::string kData = std::string(DYNID_SOURCE_DIR) + "/tests/data/models/";
+using test_support::kModelsDir;
 
 /// Runs f and returns the dynid::Error message (fails the test if nothing or something else is
 /// thrown).
@@ -237,7 +238,7 @@ TEST(UrdfLoader, ContinuousLimitsAndDynamics) {
 }
 
 TEST(UrdfLoader, LoadsFileAndKeepsLimits) {
-  const Model model = load_urdf(kData + "two_link.urdf");
+  const Model model = load_urdf(kModelsDir + "two_link.urdf");
   ASSERT_EQ(model.dof(), 2);
   EXPECT_DOUBLE_EQ(model.joints[0].limits.lower, -1.0);
   EXPECT_DOUBLE_EQ(model.joints[0].limits.upper, 1.0);
@@ -248,32 +249,33 @@ TEST(UrdfLoader, LoadsFileAndKeepsLimits) {
 }
 
 TEST(UrdfLoaderErrors, MalformedXml) {
-  const std::string msg = error_of([] { load_urdf(kData + "malformed.urdf"); });
+  const std::string msg = error_of([] { load_urdf(kModelsDir + "malformed.urdf"); });
   EXPECT_NE(msg.find("malformed.urdf"), std::string::npos) << msg;
   EXPECT_NE(msg.find("not well-formed XML"), std::string::npos) << msg;
 }
 
 TEST(UrdfLoaderErrors, UnsupportedFloatingJoint) {
-  const std::string msg = error_of([] { load_urdf(kData + "floating.urdf"); });
+  const std::string msg = error_of([] { load_urdf(kModelsDir + "floating.urdf"); });
   EXPECT_NE(msg.find("joint 'free_flyer'"), std::string::npos) << msg;
   EXPECT_NE(msg.find("unsupported type 'floating'"), std::string::npos) << msg;
   EXPECT_NE(msg.find("revolute, continuous, prismatic and fixed"), std::string::npos) << msg;
 }
 
 TEST(UrdfLoaderErrors, NegativeMass) {
-  const std::string msg = error_of([] { load_urdf(kData + "negative_mass.urdf"); });
+  const std::string msg = error_of([] { load_urdf(kModelsDir + "negative_mass.urdf"); });
   EXPECT_NE(msg.find("link 'l1' has negative mass"), std::string::npos) << msg;
 }
 
 TEST(UrdfLoaderErrors, TriangleInequality) {
-  const std::string msg = error_of([] { load_urdf(kData + "triangle.urdf"); });
+  const std::string msg = error_of([] { load_urdf(kModelsDir + "triangle.urdf"); });
   EXPECT_NE(msg.find("link 'l1' has a non-physical inertia"), std::string::npos) << msg;
   EXPECT_NE(msg.find("triangle inequality"), std::string::npos) << msg;
 }
 
 TEST(UrdfLoaderErrors, MissingFile) {
-  const std::string msg = error_of([] { load_urdf(kData + "no_such_robot.urdf"); });
-  EXPECT_NE(msg.find("cannot open robot file '" + kData + "no_such_robot.urdf'"), std::string::npos)
+  const std::string msg = error_of([] { load_urdf(kModelsDir + "no_such_robot.urdf"); });
+  EXPECT_NE(msg.find("cannot open robot file '" + kModelsDir + "no_such_robot.urdf'"),
+            std::string::npos)
       << msg;
 }
 
@@ -363,7 +365,7 @@ TEST(UrdfLoaderErrors, DeviceWithoutEndIsCutAtTheSizeLimit) {
   // A device is refused before it is opened (issue 27 item 4).
   EXPECT_NE(msg.find("robot file '/dev/zero' is not a regular file (a device)"), std::string::npos)
       << msg;
-  const std::string dir = error_of([] { load_urdf(kData); });
+  const std::string dir = error_of([] { load_urdf(kModelsDir); });
   EXPECT_NE(dir.find("is a directory"), std::string::npos) << dir;
 }
 

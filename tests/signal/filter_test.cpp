@@ -13,11 +13,12 @@
 #include "dynid/signal/period_averaging.hpp"
 #include "dynid/signal/periodic_filter.hpp"
 #include "dynid/signal/zero_phase_filter.hpp"
+#include "support/test_constants.hpp"
 
 namespace dynid {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using test_support::kPi;
 
 // Independent oracle: Chebyshev polynomial T_N(x) by its trigonometric/hyperbolic closed form.
 double chebyshev_t(int n, double x) {

@@ -11,11 +11,12 @@
 #include "dynid/signal/lowpass_design.hpp"
 #include "dynid/signal/noise_floor.hpp"
 #include "dynid/signal/zero_phase_filter.hpp"
+#include "support/test_constants.hpp"
 
 namespace dynid {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using test_support::kPi;
 
 // Two joints at `rate` for `seconds` plus white noise σ: joint 1 a robot-like motion, harmonics of
 // 0.3 Hz up to `top` Hz with amplitudes 1/k (a contiguous band); joint 2 one 0.3 Hz sinusoid and,

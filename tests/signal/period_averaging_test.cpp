@@ -10,11 +10,12 @@
 #include "dynid/common/error.hpp"
 #include "dynid/signal/period_averaging.hpp"
 #include "support/error_of.hpp"
+#include "support/test_constants.hpp"
 
 namespace dynid {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using test_support::kPi;
 
 using testing::expect_message;
 

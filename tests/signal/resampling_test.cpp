@@ -9,11 +9,12 @@
 #include "dynid/common/error.hpp"
 #include "dynid/signal/resampling.hpp"
 #include "support/error_of.hpp"
+#include "support/test_constants.hpp"
 
 namespace dynid {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using test_support::kPi;
 
 Eigen::VectorXd jittered_time(int m, double h, unsigned seed) {
   std::mt19937 gen(seed);

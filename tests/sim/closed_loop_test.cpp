@@ -10,11 +10,12 @@
 #include "dynid/sim/closed_loop.hpp"
 #include "sim/sim_support.hpp"
 #include "support/planar2.hpp"
+#include "support/test_constants.hpp"
 
 namespace dynid {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using test_support::kPi;
 
 // A joint without gravity (axis along g) and friction is the double integrator J s² y = u. Under
 // u = (Kp + Ki/s)(r − y) + Kd (s r − s/(1 + Tf s) y) the error is

@@ -17,7 +17,7 @@
 namespace dynid {
 namespace {
 
-constexpr double kRate = 200.0;
+constexpr double kComputedTorqueRate = 200.0;
 
 // Y_b(q, dq, ddq)·theta_b, Y_b the base columns of the standard regressor (the oracle: no RNEA of
 // the identified model, no mass-matrix algorithm).
@@ -94,12 +94,12 @@ struct Comparison {
 const Comparison& comparison() {
   static const Comparison c = [] {
     const Model plant = testing::planar2_with_friction();
-    const TrajectorySamples tr =
-        sample_trajectory(FourierTrajectory(testing::planar2_reference()), kRate, false);
+    const TrajectorySamples tr = sample_trajectory(FourierTrajectory(testing::planar2_reference()),
+                                                   kComputedTorqueRate, false);
     const JointRecord run =
         testing::closed_loop_run(plant, tr, testing::noisy_sensors(1e-4, 0.05, 7, 4));
     IdentifyOptions io;
-    io.signal.torque_time_offset = 0.5 / kRate;
+    io.signal.torque_time_offset = 0.5 / kComputedTorqueRate;
     const IdentificationResult r = identify(plant, run, io);
     ControlComparisonOptions co;
     co.simulate.loop.periods = 2;

@@ -23,11 +23,11 @@
 namespace dynid {
 namespace {
 
-constexpr double kRate = 200.0;  // seed 2's controller rate
+constexpr double kControllerRate = 200.0;  // seed 2's controller rate
 
 // One 4 s period of a sine per joint inside the joint limits (centred at 60 % of the range: away
 // from the straight-up pose at mid-range, where a 7-joint arm's inertias about joints 1, 3, 5, 7
-// vary a hundredfold; amplitude ≤ 0.3 rad or a quarter of the range), sampled at kRate.
+// vary a hundredfold; amplitude ≤ 0.3 rad or a quarter of the range), sampled at kControllerRate.
 Reference reference_for(const Model& model) {
   const int n = model.dof();
   Eigen::VectorXd a(n), c(n);
@@ -37,7 +37,8 @@ Reference reference_for(const Model& model) {
     c[j] = bounded ? l.lower + 0.6 * (l.upper - l.lower) : 0.0;
     a[j] = bounded ? std::min(0.3, 0.25 * (l.upper - l.lower)) : 0.3;
   }
-  return testing::sine_reference(a, c, 2 * M_PI / 4.0, 1.0 / kRate, static_cast<int>(4 * kRate));
+  return testing::sine_reference(a, c, 2 * M_PI / 4.0, 1.0 / kControllerRate,
+                                 static_cast<int>(4 * kControllerRate));
 }
 
 double rms_tracking_error(const ClosedLoopResult& r) {
@@ -130,9 +131,9 @@ TEST(ControllerChoice, NewRuleBoundsTheCoupledModeAndTheLag) {
   const double b = arm.m2 * (arm.lc2 * arm.lc2 + arm.l1 * arm.lc2) + arm.I2;
   const double c = arm.m2 * arm.lc2 * arm.lc2 + arm.I2;
   const double mu_max = std::sqrt(a * c) / (std::sqrt(a * c) - b);
-  const PidOptions old_rule = default_pid_options(model, q0, kRate, 0);
-  const PidOptions pid = default_pid_options(model, q0, kRate, 0, FeedForward::kNone);
-  const PidOptions delayed = default_pid_options(model, q0, kRate, 1);
+  const PidOptions old_rule = default_pid_options(model, q0, kControllerRate, 0);
+  const PidOptions pid = default_pid_options(model, q0, kControllerRate, 0, FeedForward::kNone);
+  const PidOptions delayed = default_pid_options(model, q0, kControllerRate, 1);
   // Historical rule: kp = M_jj·ω², ω = 2π·rate/40 at 200 Hz.
   EXPECT_NEAR(old_rule.kp[0], a * std::pow(2 * M_PI * 5.0, 2), 1e-9 * old_rule.kp[0]);
   EXPECT_NEAR(pid.kp[1] / old_rule.kp[1], 1.0 / mu_max, 1e-12);
@@ -143,7 +144,7 @@ TEST(ControllerChoice, NewRuleBoundsTheCoupledModeAndTheLag) {
   EXPECT_EQ(old_rule.feed_forward, FeedForward::kComputedTorque);
   EXPECT_EQ(pid.feed_forward, FeedForward::kNone);
   EXPECT_NE(testing::error_of([&] {
-              default_pid_options(model, q0, kRate, -1);
+              default_pid_options(model, q0, kControllerRate, -1);
             }).find("measurement delay must be >= 0"),
             std::string::npos);
 }
@@ -154,11 +155,11 @@ TEST(ControllerChoice, NewRuleBoundsTheCoupledModeAndTheLag) {
 // unstable mode grows from it instead (chatter, docs/methods/sim.md "torque chatter").
 double torque_jump_after_step(double q2, double* kick) {
   const Model model = load_robot("planar2");
-  const int m = static_cast<int>(2 * kRate);
+  const int m = static_cast<int>(2 * kControllerRate);
   Eigen::VectorXd t(m);
   Eigen::MatrixXd q(m, 2), zero = Eigen::MatrixXd::Zero(m, 2);
   for (int k = 0; k < m; ++k) {
-    t[k] = k / kRate;
+    t[k] = k / kControllerRate;
     q.row(k) << 0.2 + (k >= m / 4 ? 1e-3 : 0.0), q2;
   }
   SimulateOptions o;

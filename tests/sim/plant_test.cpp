@@ -9,11 +9,12 @@
 #include "dynid/sim/plant.hpp"
 #include "sim/sim_support.hpp"
 #include "support/random_models.hpp"
+#include "support/test_constants.hpp"
 
 namespace dynid {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using test_support::kPi;
 
 PlantOptions native(double dt, int substeps = 1) {
   PlantOptions o;

@@ -6,11 +6,12 @@
 #include "dynid/common/error.hpp"
 #include "dynid/sim/sensors.hpp"
 #include "support/random_models.hpp"
+#include "support/test_constants.hpp"
 
 namespace dynid {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using test_support::kPi;
 
 // Sample mean and std of N draws: mean within 5σ/√N, std within 5·σ/√(2N) (its standard error).
 TEST(Sensors, NoiseHasRequestedMeanAndStd) {

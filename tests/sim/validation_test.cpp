@@ -10,11 +10,12 @@
 #include "dynid/sim/simulation_validation.hpp"
 #include "sim/sim_support.hpp"
 #include "support/planar2.hpp"
+#include "support/test_constants.hpp"
 
 namespace dynid {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using test_support::kPi;
 
 // e = (1, 2, 3, 4, 10): μ = 4, deviations (−3, −2, −1, 0, 6), m2 = 10, m3 = 36, m4 = 278.8, so
 // σ = √10, skewness = 36/10^1.5, kurtosis = 2.788, rms = √(130/5), max = 10 (by hand).
