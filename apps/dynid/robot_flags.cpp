@@ -75,26 +75,28 @@ std::vector<std::string> joints_of_header(const Model& model, const RobotContext
 }  // namespace
 
 void add_robot_flags(CLI::App* cmd, RobotFlags& flags, RobotFlagDefaults defaults) {
-  const std::string stored = defaults == RobotFlagDefaults::kStoredInParams
-                                 ? "; default: the joints identify locked (stored in --params)"
-                                 : "";
-  cmd->add_option("--joints", flags.joints,
-                  "The robot's joints the log holds, in the log's order (comma separated names): "
-                  "joint j of the log (q<j>, tau<j>) is the j-th; every other moving joint is "
-                  "held fixed at its --lock value and its links' inertia merges into the link "
-                  "carrying it. Default: the joints the log's header names as q_<name>, else "
-                  "all" +
-                      stored)
+  const bool stored = defaults == RobotFlagDefaults::kStoredInParams;
+  cmd->add_option(
+         "--joints", flags.joints,
+         "The robot's joints the log holds, in the log's order (comma separated names): "
+         "joint j of the log (q<j>, tau<j>) is the j-th; every other moving joint is "
+         "held fixed at its --lock value and its links' inertia merges into the link "
+         "carrying it. Default: " +
+             std::string(stored ? "the joints identify used (stored in --params), else " : "") +
+             "the joints the log's header names as q_<name>, else all")
       ->delimiter(',');
-  cmd->add_option("--lock", flags.locks,
-                  "NAME=VALUE: a joint not identified is held at VALUE [rad or m] (default 0); "
-                  "repeat or comma separate; alone, it locks the named joints and keeps the rest" +
-                      stored)
+  cmd->add_option(
+         "--lock", flags.locks,
+         "NAME=VALUE: a joint not identified is held at VALUE [rad or m], at 0 when not "
+         "named; repeat or comma separate; alone, it locks the named joints and keeps "
+         "the rest" +
+             std::string(stored ? ". Default: the locks identify used (stored in --params)" : ""))
       ->delimiter(',');
   cmd->add_flag("--strict", flags.strict,
                 "Refuse a robot file whose link inertia is not physical (not positive "
-                "semi-definite or breaking the triangle inequality); default: load it with one "
-                "warning per link, as vendor URDFs often break it by a few percent");
+                "semi-definite or breaking the triangle inequality) or whose <limit> lacks effort "
+                "or velocity; default: load it with one warning each (vendor URDFs break the "
+                "triangle inequality by a few percent; the limit is read as unlimited)");
 }
 
 JointSelection selection_stored_in(const std::string& params) {
@@ -116,26 +118,30 @@ JointSelection selection_stored_in(const std::string& params) {
 
 Model load_cli_robot(const std::string& robot, const RobotFlags& flags,
                      const RobotContext& context) {
+  JointSelection selection;
+  selection.joints = flags.joints;
+  selection.locks = parse_locks(flags.locks);
   RobotOptions options;
   options.strict = flags.strict;
-  options.selection.joints = flags.joints;
-  options.selection.locks = parse_locks(flags.locks);
-  std::string from;
-  if (options.selection.empty() && !context.stored.empty()) {
-    options.selection = context.stored;
-    from = "(as identified: stored in '" + context.stored_from + "')";
-  }
   LoadedRobot loaded = load_robot(robot, options);
   for (const std::string& w : loaded.warnings) std::cerr << "warning: " << one_line(w) << '\n';
-  if (options.selection.empty()) {
-    const std::vector<std::string> kept = joints_of_header(loaded.model, context);
-    if (!kept.empty()) {
-      JointSelection by_name;
-      by_name.joints = kept;
-      loaded.model = lock_joints(loaded.model, by_name);
+  std::string from;
+  if (selection.empty() && !context.stored.empty()) {
+    try {
+      loaded.model = lock_joints(loaded.model, context.stored);
+    } catch (
+        const Error& e) {  // a result's joints may not fit this robot: say where they came from
+      throw Error(std::string(e.what()) + " (the joints identify used, stored in '" +
+                  context.stored_from + "'; give --joints and --lock for this robot)");
+    }
+    from = "(as identified: stored in '" + context.stored_from + "')";
+  } else if (selection.empty()) {
+    selection.joints = joints_of_header(loaded.model, context);
+    if (!selection.joints.empty()) {
       from = "(not in '" + context.runs.front() + "'; --joints and --lock choose)";
     }
   }
+  loaded.model = lock_joints(loaded.model, selection);
   if (!loaded.model.locked_joints.empty()) {
     std::cerr << context.command << ": locked joints" << (from.empty() ? "" : " ") << one_line(from)
               << ": " << one_line(lock_list(loaded.model.locked_joints))
