@@ -750,7 +750,6 @@ void add_identify_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "identify", "Identify base parameters, friction and actuator inertias from a recorded run");
   cmd->add_option("--robot,-r", o->robot, "Built-in robot name or .urdf/.yaml model")->required();
-  add_robot_flags(cmd, o->robot_flags);
   cmd->add_option("--data,-d", o->runs,
                   "Run CSV: t (or --rate), q* or qm* (motor side), tau* or taum*, optional dq*, "
                   "ddq*; repeat --data to identify from several runs together (each is "
@@ -836,6 +835,7 @@ void add_identify_command(CLI::App& app) {
                   "on it beyond round-off")
       ->capture_default_str();
   add_signal_flags(cmd, *o);
+  add_robot_flags(cmd, o->robot_flags);
   cmd->add_option("--outliers", o->outliers,
                   "Gross torque outliers (Hampel test): report (warn, keep them) or drop (replace "
                   "each by its neighbours' median)")

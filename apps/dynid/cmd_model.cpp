@@ -71,7 +71,7 @@ void add_model_command(CLI::App& app) {
   add_robot_flags(cmd, options->robot_flags);
   cmd->add_option("--json", options->json,
                   "Also write the model as JSON to this file (keys: name, source, dof, gravity, "
-                  "joints, standard_parameters, friction, transmission, version)");
+                  "joints, standard_parameters, friction, transmission, locked_joints, version)");
   cmd->add_flag("--base", options->base,
                 "Also compute the base parameters (numerical Gautier-Khalil), their regrouping "
                 "expressions and the parameters with no effect; JSON keys base_parameters, "

@@ -48,8 +48,8 @@ std::string joint_list(const Model& model) {
 }
 
 // The robot's joints the first run's header names as q_<name>, in model order (so the tree
-// order holds); empty when the header names none, or all, or cannot be read (the command's own
-// reading reports that).
+// order holds); empty when the header names none, or all, has numbered position columns, or
+// cannot be read (the command's own reading reports that).
 std::vector<std::string> joints_of_header(const Model& model, const RobotContext& context) {
   if (context.runs.empty() || columns_by_position(context.columns)) return {};
   std::vector<std::string> header;
@@ -61,6 +61,15 @@ std::vector<std::string> joints_of_header(const Model& model, const RobotContext
   for (auto& name : header) {
     for (const auto& [from, to] : context.columns)
       if (name == from) name = to;
+  }
+  // A numbered position column (q1, qm2) counts joints by model index: the log then names
+  // joints by number, not by name, and nothing is matched.
+  for (const std::string& c : header) {
+    for (const std::string prefix : {"q", "qm"}) {
+      if (c.size() > prefix.size() && c.compare(0, prefix.size(), prefix) == 0 &&
+          c.find_first_not_of("0123456789", prefix.size()) == std::string::npos)
+        return {};
+    }
   }
   std::vector<std::string> names;
   for (const Joint& j : model.joints) names.push_back(j.name);

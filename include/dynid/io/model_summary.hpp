@@ -13,7 +13,8 @@ namespace dynid {
 /// joints (list of {name, link, type, parent (joint name or null for the base), lower, upper,
 /// velocity, effort}; infinite limits are null), standard_parameters (list of {name, value} in
 /// Model::standard_parameter_names() order, SI units about each link origin), friction (one
-/// {joint, Ia, Fv, Fc, Fo} per joint), transmission {N (list of rows), q_offset}, version.
+/// {joint, Ia, Fv, Fc, Fo} per joint), transmission {N (list of rows), q_offset}, locked_joints
+/// (locked_joints_to_json), version.
 nlohmann::json model_to_json(const Model& model);
 
 /// `locked_joints` of every result JSON (issue 26 item 1): [{name, value}] of
