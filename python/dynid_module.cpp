@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <tuple>
@@ -563,6 +564,14 @@ PYBIND11_MODULE(dynid, m) {
                              "M, about the link origin)")
       .def_property_readonly("standard_parameter_names", &Model::standard_parameter_names,
                              "Names of standard_parameters (XX1 ... Mn)")
+      .def_property_readonly(
+          "locked_joints",
+          [](const Model& model) {
+            std::map<std::string, double> locked;
+            for (const JointLock& l : model.locked_joints) locked[l.name] = l.value;
+            return locked;
+          },
+          "Joints of the robot file held fixed by load_model(lock=...): name -> value [rad or m]")
       .def(
           "summary", [](const Model& model) { return to_python(model_to_json(model)); },
           "The model as a dict with the keys of 'dynid model --json'")
@@ -570,8 +579,27 @@ PYBIND11_MODULE(dynid, m) {
         return "<dynid.Model '" + model.name + "' with " + std::to_string(model.dof()) + " joints>";
       });
 
-  m.def("load_model", &load_robot, py::arg("path_or_name"),
-        "Loads a built-in robot by short name (e.g. 'puma560') or a .urdf / .yaml model file.");
+  m.def(
+      "load_model",
+      [](const std::string& path_or_name, const std::vector<std::string>& joints,
+         const std::map<std::string, double>& lock, bool strict) {
+        RobotOptions options;
+        options.strict = strict;
+        options.selection.joints = joints;
+        for (const auto& [name, value] : lock) options.selection.locks.push_back({name, value});
+        LoadedRobot loaded = load_robot(path_or_name, options);
+        for (const std::string& w : loaded.warnings) {
+          if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) throw py::error_already_set();
+        }
+        return loaded.model;
+      },
+      py::arg("path_or_name"), py::arg("joints") = std::vector<std::string>{},
+      py::arg("lock") = std::map<std::string, double>{}, py::arg("strict") = false,
+      "Loads a built-in robot by short name (e.g. 'puma560') or a .urdf / .yaml model file. "
+      "joints: the joints identified, in the log's order (default: all); every other moving joint "
+      "is held fixed at lock[name] [rad or m] (default 0) and its links merge into the link "
+      "carrying it (as the CLI's --joints/--lock). A non-physical link inertia is a UserWarning, "
+      "or an error with strict=True (--strict).");
 
   m.def("inverse_dynamics", &inverse_dynamics, py::arg("model"), py::arg("q"), py::arg("dq"),
         py::arg("ddq"), py::arg("joint_terms") = true,

@@ -14,12 +14,14 @@
 #include "dynid/report/stored_result.hpp"
 #include "dynid/sim/control_comparison.hpp"
 #include "dynid/sim/pid_gains.hpp"
+#include "robot_flags.hpp"
 
 namespace dynid::cli {
 namespace {
 
 struct CompareControlCliOptions {
   std::string robot, params, trajectory, engine = "mujoco", gains, json;
+  RobotFlags robot_flags;  // --joints, --lock, --strict
   int periods = 3;
   double reversal_window = 0.05;
 };
@@ -32,7 +34,9 @@ void run(const CompareControlCliOptions& o) {
     throw UsageError("--periods must be >= 2 (the first period is the start-up, left out)");
   }
   if (!(o.reversal_window >= 0.0)) throw UsageError("--reversal-window must be >= 0 [s]");
-  const Model model = load_robot(o.robot);
+  const Model model = load_cli_robot(
+      o.robot, o.robot_flags,
+      {"compare-control", {o.trajectory}, {}, selection_stored_in(o.params), o.params});
   const CompletedModel identified = completed_model_from_result(model, o.params, "compare-control");
   const JointRecord ref = read_reference(o.trajectory, model);
   ControlComparisonOptions c;
@@ -63,6 +67,7 @@ void add_compare_control_command(CLI::App& app) {
       "reversals of the tracking error");
   cmd->add_option("--robot,-r", o->robot, "Built-in robot name or .urdf/.yaml model (the plant)")
       ->required();
+  add_robot_flags(cmd, o->robot_flags, RobotFlagDefaults::kStoredInParams);
   cmd->add_option("--params,-p", o->params,
                   "result.json of dynid identify: the model of the computed-torque controller; "
                   "parameters its data did not determine take the --robot model's values "

@@ -22,12 +22,14 @@
 #include "dynid/io/json_writer.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/report/excitation_report.hpp"
+#include "robot_flags.hpp"
 
 namespace dynid::cli {
 namespace {
 
 struct ExciteCliOptions {
   std::string robot, out, json, criterion = "cond";
+  RobotFlags robot_flags;  // --joints, --lock, --strict
   int harmonics = 5, starts = 4, max_evaluations = 3000;
   double f0 = 0.1, f_max = 0.0, rate = 100.0, max_time = 10.0, z_min = -1e300;
   double limit_fraction = 1.0;
@@ -199,7 +201,7 @@ void run_joint_experiment(const ExciteCliOptions& o) {
   if (!(o.limit_fraction > 0.0 && o.limit_fraction <= 1.0)) {
     throw UsageError("--limit-fraction must be in (0, 1]");
   }
-  const Model model = load_robot(o.robot);
+  const Model model = load_cli_robot(o.robot, o.robot_flags, {"excite", {}, {}, {}, ""});
   TrajectorySamples samples;
   try {
     samples = joint_experiment(model, o);
@@ -295,7 +297,7 @@ void run_excite(const ExciteCliOptions& o) {
     throw UsageError("--criterion must be cond or logdet, not '" + o.criterion + "'");
   }
   if (!(o.rate > 0.0)) throw UsageError("--rate must be > 0 Hz");
-  const Model model = load_robot(o.robot);
+  const Model model = load_cli_robot(o.robot, o.robot_flags, {"excite", {}, {}, {}, ""});
   ExcitationOptions options;
   options.criterion = o.criterion == "cond" ? ExcitationCriterion::kConditionNumber
                                             : ExcitationCriterion::kDOptimality;
@@ -349,6 +351,7 @@ void add_excite_command(CLI::App& app) {
       "Optimise a finite-Fourier-series excitation (condition number or D-optimality), or write "
       "a one-joint experiment reference (--family ... --joint J)");
   cmd->add_option("--robot,-r", o->robot, "Built-in robot name or .urdf/.yaml model")->required();
+  add_robot_flags(cmd, o->robot_flags);
   cmd->add_option("--out,-o", o->out, "Trajectory CSV: t, q1..qn, dq1..dqn, ddq1..ddqn")
       ->required();
   cmd->add_option("--json", o->json,

@@ -6,17 +6,18 @@
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
 #include "dynid/io/atomic_file.hpp"
-#include "dynid/model/robots.hpp"
 #include "dynid/physical/urdf_export.hpp"
 #include "flag_checks.hpp"
+#include "robot_flags.hpp"
 
 namespace dynid::cli {
 namespace {
 
 struct ExportOptions {
-  std::string robot;   // built-in name or .urdf/.yaml path the parameters were identified on
-  std::string params;  // result JSON of identify --physical
-  std::string out;     // URDF to write
+  std::string robot;       // built-in name or .urdf/.yaml path the parameters were identified on
+  std::string params;      // result JSON of identify --physical
+  std::string out;         // URDF to write
+  RobotFlags robot_flags;  // --joints, --lock, --strict: default the ones stored in --params
 };
 
 void run_export(const ExportOptions& o) {
@@ -27,8 +28,10 @@ void run_export(const ExportOptions& o) {
     throw Error("--out '" + o.out + "': folder '" + folder.string() +
                 "' does not exist; create it or write elsewhere");
   }
-  const Model model = load_robot(o.robot);
   const ConsistentParameterFile file = read_consistent_parameters(o.params);
+  RobotContext context{"export", {}, {}, {}, o.params};
+  if (!file.locked_joints.empty()) context.stored = {file.joints, file.locked_joints};
+  const Model model = load_cli_robot(o.robot, o.robot_flags, context);
   require_same_robot(file.robot, model.name, "'" + o.params + "'",
                      "export with the robot the parameters were identified on");
   if (!file.joints.empty()) {
@@ -63,9 +66,11 @@ void add_export_command(CLI::App& app) {
       "Write physically consistent identified parameters (identify --physical) as a URDF");
   cmd->add_option("--robot,-r", o->robot,
                   "Built-in robot name or .urdf/.yaml model the parameters were identified on; a "
-                  "URDF is edited (inertials, joint <dynamics>), other models are written with "
+                  "URDF (or the urdf: of a YAML model) is edited (inertials, joint <dynamics>), "
+                  "other models are written with "
                   "the same frames")
       ->required();
+  add_robot_flags(cmd, o->robot_flags, RobotFlagDefaults::kStoredInParams);
   cmd->add_option("--params,-p", o->params,
                   "Result JSON of 'dynid identify --physical' (its standard_parameters)")
       ->required();

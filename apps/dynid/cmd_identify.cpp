@@ -25,6 +25,7 @@
 #include "dynid/io/closed_loop_file.hpp"
 #include "dynid/io/joint_record_file.hpp"
 #include "dynid/io/json_writer.hpp"
+#include "dynid/io/model_summary.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/physical/completed_model.hpp"
 #include "dynid/physical/identified_model.hpp"
@@ -37,6 +38,7 @@
 #include "dynid/sim/pid_gains.hpp"
 #include "dynid/sim/simulate_reference.hpp"
 #include "flag_checks.hpp"
+#include "robot_flags.hpp"
 #include "run_flags.hpp"
 
 namespace dynid::cli {
@@ -45,6 +47,7 @@ namespace {
 struct IdentifyCliOptions {
   std::string robot, data, out;
   RunFlags run;                   // --rate, --columns, --torque-scale, --rows, --time, ...
+  RobotFlags robot_flags;         // --joints, --lock, --strict
   std::vector<std::string> runs;  // --data, repeatable (identify)
   std::string history;            // --history (identify, rls)
   std::string friction = "viscous,coulomb,offset";
@@ -227,7 +230,10 @@ nlohmann::json echo(const IdentifyCliOptions& o) {
           {"f0", o.f0},
           {"noise", o.noise},
           {"noise_std", o.noise_std},
-          {"repeat", o.repeat}};
+          {"repeat", o.repeat},
+          {"joints", o.robot_flags.joints},
+          {"lock", o.robot_flags.locks},
+          {"strict", o.robot_flags.strict}};
 }
 
 void add_signal_flags(CLI::App* cmd, IdentifyCliOptions& o) {
@@ -316,7 +322,8 @@ void run_experiment(const IdentifyCliOptions& o, const IdentifyOptions& options,
   if (options.estimator != IdentificationEstimator::kOls) {
     throw UsageError("--model " + o.model + " fits by least squares; drop --estimator");
   }
-  const Model model = load_robot(o.robot);
+  const Model model =
+      load_cli_robot(o.robot, o.robot_flags, {"identify", o.runs, file.columns, {}, ""});
   if (o.joint < 1 || o.joint > model.dof()) {
     throw UsageError("--joint " + std::to_string(o.joint) + " is not a joint of '" + model.name +
                      "'; give 1 to " + std::to_string(model.dof()));
@@ -372,6 +379,7 @@ void run_experiment(const IdentifyCliOptions& o, const IdentifyOptions& options,
     r.choices.insert(r.choices.begin(), choices.begin(), choices.end());
     result = decoupled_model_to_json(model, r, used);
   }
+  result["locked_joints"] = locked_joints_to_json(model);
   std::vector<std::pair<std::string, std::string>> echoed;
   for (auto& [k, v] : result["choices"].items()) echoed.emplace_back(k, v.get<std::string>());
   echo_choices("identify", read, echoed);
@@ -455,7 +463,8 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     run_experiment(o, options, file);
     return;
   }
-  const Model model = load_robot(o.robot);
+  const Model model =
+      load_cli_robot(o.robot, o.robot_flags, {"identify", o.runs, file.columns, {}, ""});
   RunFileReport read;
   IdentificationResult result;
   RepeatedEstimate repeated;
@@ -572,6 +581,7 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
 struct ValidateCliOptions {
   std::string robot, params, data, json, mode = "torque", trajectory, engine = "mujoco";
   RunFlags run;  // --rate, --columns, --torque-scale, ...: default the ones stored in --params
+  RobotFlags robot_flags;  // --joints, --lock, --strict: default the ones stored in --params
   std::string predicted;
   std::string controller, gains, histograms;  // --mode simulation: the run's loop, error PDFs
   std::string report;                         // --report
@@ -609,8 +619,10 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
       warn("--controller, --gains and --histograms have no effect with --mode torque");
     }
   }
-  const Model model = load_robot(v.robot);
   const IdentifiedResultFile identified = read_identification_result(v.params);
+  const Model model =
+      load_cli_robot(v.robot, v.robot_flags,
+                     {"validate", {v.data}, file.columns, selection_stored_in(v.params), v.params});
   require_same_robot(identified.robot, model.name, "'" + v.params + "'",
                      "validate with the robot the parameters were identified on");
   std::vector<std::string> names = identified.names;
@@ -823,6 +835,7 @@ void add_identify_command(CLI::App& app) {
                   "on it beyond round-off")
       ->capture_default_str();
   add_signal_flags(cmd, *o);
+  add_robot_flags(cmd, o->robot_flags);
   cmd->add_option("--outliers", o->outliers,
                   "Gross torque outliers (Hampel test): report (warn, keep them) or drop (replace "
                   "each by its neighbours' median)")
@@ -836,6 +849,7 @@ void add_validate_command(CLI::App& app) {
       "validate",
       "Predict the torques of another run with identified parameters and report errors");
   cmd->add_option("--robot,-r", v->robot, "Built-in robot name or .urdf/.yaml model")->required();
+  add_robot_flags(cmd, v->robot_flags, RobotFlagDefaults::kStoredInParams);
   cmd->add_option("--params,-p", v->params, "result.json written by dynid identify")->required();
   cmd->add_option("--data,-d", v->data, "Run CSV to predict (same format as identify)")->required();
   cmd->add_option("--json", v->json,

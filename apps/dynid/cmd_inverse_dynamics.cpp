@@ -4,7 +4,7 @@
 
 #include "commands.hpp"
 #include "dynid/io/inverse_dynamics_file.hpp"
-#include "dynid/model/robots.hpp"
+#include "robot_flags.hpp"
 
 namespace dynid::cli {
 namespace {
@@ -14,14 +14,16 @@ struct InverseDynamicsCliOptions {
   std::string in;     // states CSV
   std::string out;    // torques CSV
   bool no_friction = false;
-  std::string columns;  // --columns from=to,...
+  std::string columns;     // --columns from=to,...
+  RobotFlags robot_flags;  // --joints, --lock, --strict
 };
 
 void run_inverse_dynamics(const InverseDynamicsCliOptions& cli) {
   InverseDynamicsFileOptions options;
   options.joint_terms = !cli.no_friction;
   options.columns = parse_column_mapping(cli.columns);
-  const Model model = load_robot(cli.robot);
+  const Model model = load_cli_robot(cli.robot, cli.robot_flags,
+                                     {"inverse-dynamics", {cli.in}, options.columns, {}, ""});
   const Eigen::Index rows = inverse_dynamics_file(model, cli.in, cli.out, options);
   std::cout << "wrote " << rows << " rows of tau1..tau" << model.dof() << " to " << cli.out << '\n';
 }
@@ -36,6 +38,7 @@ void add_inverse_dynamics_command(CLI::App& app) {
       "every row of a states CSV (recursive Newton-Euler)");
   cmd->add_option("--robot,-r", options->robot, "Built-in robot name or a .urdf / .yaml model file")
       ->required();
+  add_robot_flags(cmd, options->robot_flags);
   cmd->add_option("--in,-i", options->in,
                   "States CSV with columns q1..qn, dq1..dqn, ddq1..ddqn (or q_<joint name>, ...) "
                   "in any order; t optional (must increase); other columns ignored")

@@ -9,6 +9,7 @@
 #include "dynid/io/model_summary.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/report/identification_report.hpp"
+#include "robot_flags.hpp"
 
 namespace dynid::cli {
 namespace {
@@ -18,6 +19,7 @@ struct ModelOptions {
   std::string json;               // optional JSON output path
   bool base = false;              // also compute the base parameters
   std::string friction = "none";  // per-joint columns classified with the link parameters
+  RobotFlags robot_flags;         // --joints, --lock, --strict
 };
 
 ParameterLayout parse_layout(const std::string& text) {
@@ -31,7 +33,7 @@ void run_model(const ModelOptions& options, const CLI::App& cmd) {
   if (!options.base && cmd.count("--friction")) {
     std::cerr << "warning: --friction has no effect without --base\n";
   }
-  const Model model = load_robot(options.robot);
+  const Model model = load_cli_robot(options.robot, options.robot_flags, {"model", {}, {}, {}, ""});
   std::cout << model_summary_text(model);
   nlohmann::json json = model_to_json(model);
   if (options.base) {
@@ -66,9 +68,10 @@ void add_model_command(CLI::App& app) {
              }() +
              ") or a .urdf / .yaml model file")
       ->required();
+  add_robot_flags(cmd, options->robot_flags);
   cmd->add_option("--json", options->json,
                   "Also write the model as JSON to this file (keys: name, source, dof, gravity, "
-                  "joints, standard_parameters, friction, transmission, version)");
+                  "joints, standard_parameters, friction, transmission, locked_joints, version)");
   cmd->add_flag("--base", options->base,
                 "Also compute the base parameters (numerical Gautier-Khalil), their regrouping "
                 "expressions and the parameters with no effect; JSON keys base_parameters, "

@@ -31,6 +31,7 @@
 #include "dynid/report/stored_result.hpp"
 #include "dynid/version.hpp"
 #include "flag_checks.hpp"
+#include "robot_flags.hpp"
 #include "run_flags.hpp"
 
 namespace dynid::cli {
@@ -39,6 +40,7 @@ namespace {
 struct PayloadCliOptions {
   std::string data, robot, sensor_link, sensor_pose, out, history;
   RunFlags run;                        // --rate, --columns, --torque-scale, --rows, --time, ...
+  RobotFlags robot_flags;              // --joints, --lock, --strict
   std::string link, reference, frame;  // joint-torque mode
   std::string report;                  // --report: HTML page of the result
   std::string model = "differential";
@@ -186,7 +188,10 @@ void run_payload_from_torques(const PayloadCliOptions& cli, const CLI::App& cmd,
         "--link (load from joint torques) does not take --static, --bias, "
         "--sensor-link or --sensor-pose; use --frame to place the load's frame");
   }
-  const Model model = load_robot(cli.robot);
+  const RunFileOptions file = run_file_options(cli.run);
+  const Model model = load_cli_robot(
+      cli.robot, cli.robot_flags,
+      {"payload", {cli.data}, file.columns, selection_stored_in(cli.reference), cli.reference});
   LoadFrame frame;
   if (!cli.frame.empty()) {
     const auto pose =
@@ -196,7 +201,6 @@ void run_payload_from_torques(const PayloadCliOptions& cli, const CLI::App& cmd,
     frame.R_LF = roll_pitch_yaw(pose[3], pose[4], pose[5]);
   }
   const int link = find_link(model, cli.link);
-  const RunFileOptions file = run_file_options(cli.run);
   const bool json_reference =
       cli.reference.size() >= 5 && cli.reference.substr(cli.reference.size() - 5) == ".json";
   if (json_reference) return run_payload_from_result(cli, cmd, options, model, link, frame, file);
@@ -318,7 +322,8 @@ void run_payload(const PayloadCliOptions& cli, const CLI::App& cmd) {
   SensorMotion motion;
   nlohmann::json frame;
   if (!cli.robot.empty()) {
-    const Model model = load_robot(cli.robot);
+    const Model model =
+        load_cli_robot(cli.robot, cli.robot_flags, {"payload", {cli.data}, file.columns, {}, ""});
     SensorMount mount;
     mount.link = find_link(model, cli.sensor_link);
     if (!cli.sensor_pose.empty()) {
@@ -404,6 +409,7 @@ void add_payload_command(CLI::App& app) {
   cmd->add_option("--robot,-r", o->robot,
                   "Built-in robot name or .urdf / .yaml model: the sensor's motion comes from "
                   "its kinematics and q (dq, ddq derived and filtered as in identify)");
+  add_robot_flags(cmd, o->robot_flags);
   cmd->add_option("--sensor-link", o->sensor_link, "Link (or joint) name that carries the sensor");
   cmd->add_option("--sensor-pose", o->sensor_pose,
                   "\"x y z roll pitch yaw\" of the sensor frame in the link frame [m, rad], URDF "

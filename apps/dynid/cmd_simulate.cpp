@@ -14,13 +14,15 @@
 #include "dynid/sim/pid_gains.hpp"
 #include "dynid/sim/simulate_reference.hpp"
 #include "flag_checks.hpp"
+#include "robot_flags.hpp"
 
 namespace dynid::cli {
 namespace {
 
 struct SimulateCliOptions {
   std::string robot, trajectory, out, engine = "mujoco", controller = "pid-feedforward", gains;
-  std::string params;  // --params: identified model of computed-torque
+  std::string params;      // --params: identified model of computed-torque
+  RobotFlags robot_flags;  // --joints, --lock, --strict
   int periods = 25, delay = 0;
   unsigned seed = 1;
   double position_noise = 0.0, torque_noise = 0.0, counts_per_rev = 0.0;
@@ -74,7 +76,9 @@ void run(const SimulateCliOptions& o) {
                                         "or add --controller computed-torque");
   }
   if (o.periods < 1) throw UsageError("--periods must be >= 1");
-  const Model model = load_robot(o.robot);
+  const Model model =
+      load_cli_robot(o.robot, o.robot_flags,
+                     {"simulate", {o.trajectory}, {}, selection_stored_in(o.params), o.params});
   const std::optional<MountedLoad> load = payload_options(o, model);
   const JointRecord ref = read_reference(o.trajectory, model);
   SimulateOptions s;
@@ -134,6 +138,7 @@ void add_simulate_command(CLI::App& app) {
       "Run a reference trajectory in closed loop (PID, with or without feed-forward) on a "
       "simulated robot");
   cmd->add_option("--robot,-r", o->robot, "Built-in robot name or .urdf/.yaml model")->required();
+  add_robot_flags(cmd, o->robot_flags, RobotFlagDefaults::kStoredInParams);
   cmd->add_option(
          "--trajectory,-t", o->trajectory,
          "Reference CSV with t and q* (dq*, ddq* optional), one period, e.g. from dynid excite")

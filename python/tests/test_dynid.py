@@ -1,6 +1,8 @@
 """Tests of the dynid Python module (issue 15 item 4). Oracles: the closed-form planar 2R arm
 (written out here in NumPy), NumPy's own rank, and identification from torques of that closed
 form with noise, the truth inside the predicted intervals."""
+import os
+
 import numpy as np
 import pytest
 
@@ -12,15 +14,16 @@ M2, LC2, I2 = 1.5, 0.4, 0.08
 L1, G = 1.0, 9.81
 
 
-def planar2_torques(q, dq, ddq, m2=M2, lc2=LC2, i2=I2):
+def planar2_torques(q, dq, ddq, m2=M2, lc2=LC2, i2=I2, m1=M1, lc1=LC1, i1=I1):
     """Closed-form inverse dynamics of the planar 2R arm (Spong, Hutchinson, Vidyasagar ch. 7);
-    m2, lc2, i2: the forearm's mass, centre of mass on its x axis and inertia about it."""
+    m2, lc2, i2 (m1, lc1, i1): the forearm's (upper arm's) mass, centre of mass on its x axis and
+    inertia about it."""
     c2, s2 = np.cos(q[:, 1]), np.sin(q[:, 1])
-    m11 = I1 + M1 * LC1**2 + i2 + m2 * (L1**2 + lc2**2 + 2 * L1 * lc2 * c2)
+    m11 = i1 + m1 * lc1**2 + i2 + m2 * (L1**2 + lc2**2 + 2 * L1 * lc2 * c2)
     m12 = i2 + m2 * (lc2**2 + L1 * lc2 * c2)
     m22 = i2 + m2 * lc2**2
     h = m2 * L1 * lc2 * s2
-    g1 = (M1 * LC1 + m2 * L1) * G * np.cos(q[:, 0]) + m2 * lc2 * G * np.cos(q[:, 0] + q[:, 1])
+    g1 = (m1 * lc1 + m2 * L1) * G * np.cos(q[:, 0]) + m2 * lc2 * G * np.cos(q[:, 0] + q[:, 1])
     g2 = m2 * lc2 * G * np.cos(q[:, 0] + q[:, 1])
     tau1 = m11 * ddq[:, 0] + m12 * ddq[:, 1] - h * (2 * dq[:, 0] * dq[:, 1] + dq[:, 1] ** 2) + g1
     tau2 = m12 * ddq[:, 0] + m22 * ddq[:, 1] + h * dq[:, 0] ** 2 + g2
@@ -235,3 +238,51 @@ def test_payload_recovers_a_load_on_the_forearm_within_its_intervals(planar2):
         dynid.payload(planar2, "forearm", t, q, wrench, speed=1)
     with pytest.raises(dynid.Error, match="wrench must be"):
         dynid.payload(planar2, "forearm", t, q, wrench[:, :5])
+
+
+MODELS = os.path.join(os.path.dirname(__file__), "..", "..", "tests", "data", "models")
+
+
+def merged(parts):
+    """(mass, centre of mass on x, inertia about it) of planar parts (m, x, izz about their own
+    centre of mass), by the parallel-axis theorem about z."""
+    m = sum(p[0] for p in parts)
+    lc = sum(p[0] * p[1] for p in parts) / m
+    zz = sum(p[2] + p[0] * p[1] ** 2 for p in parts)
+    return m, lc, zz - m * lc**2
+
+
+def test_load_model_locks_the_joints_a_log_lacks():
+    """Issue 26 item 1: planar2_gripper.urdf with the finger held at 0.05 m and the camera pan at
+    pi is the planar arm whose links carry them (summed here by hand)."""
+    robot = os.path.join(MODELS, "planar2_gripper.yaml")
+    m = dynid.load_model(robot, joints=["shoulder", "elbow"],
+                         lock={"finger": 0.05, "camera_pan": np.pi})
+    assert m.dof == 2 and m.joint_names == ["shoulder", "elbow"]
+    assert m.locked_joints == {"finger": 0.05, "camera_pan": np.pi}
+    m1, lc1, i1 = merged([(2.0, 0.5, 1.0 / 6.0), (0.4, 0.5 + 0.1 * np.cos(np.pi), 0.002)])
+    m2, lc2, i2 = merged([(1.5, 0.4, 0.08), (0.3, 0.85, 0.0005)])
+    rng = np.random.default_rng(26)
+    q, dq, ddq = (rng.uniform(-2, 2, size=(40, 2)) for _ in range(3))
+    np.testing.assert_allclose(
+        dynid.inverse_dynamics(m, q, dq, ddq),
+        planar2_torques(q, dq, ddq, m2=m2, lc2=lc2, i2=i2, m1=m1, lc1=lc1, i1=i1),
+        rtol=1e-10, atol=1e-10)
+    t, q, dq, ddq = fourier_run(7)
+    tau = planar2_torques(q, dq, ddq, m2=m2, lc2=lc2, i2=i2, m1=m1, lc1=lc1, i1=i1)
+    result = dynid.identify(m, t, q, tau, dq=dq, ddq=ddq, armature=False, viscous=False,
+                            coulomb=False, offset=False, filter=False)
+    assert result["locked_joints"] == [{"name": "finger", "value": 0.05},
+                                       {"name": "camera_pan", "value": np.pi}]
+    with pytest.raises(dynid.Error, match="joint 'gripper' is not a moving joint"):
+        dynid.load_model(robot, joints=["shoulder", "gripper"])
+
+
+def test_load_model_warns_of_a_vendor_inertia_and_refuses_it_when_strict():
+    """Issue 26 item 4: a 2.9 % triangle-inequality violation is a UserWarning naming the link;
+    strict=True refuses it."""
+    path = os.path.join(MODELS, "vendor_triangle.urdf")
+    with pytest.warns(UserWarning, match="link 'wrist' has a non-physical inertia"):
+        assert dynid.load_model(path).dof == 2
+    with pytest.raises(dynid.Error, match="link 'wrist'"):
+        dynid.load_model(path, strict=True)

@@ -93,6 +93,22 @@ bool has_joint_columns(const std::vector<std::string>& columns,
   return false;
 }
 
+std::vector<std::string> joints_named_in_columns(const std::vector<std::string>& columns,
+                                                 const std::vector<std::string>& joint_names) {
+  const std::set<std::string> known(joint_names.begin(), joint_names.end());
+  std::vector<std::string> named;
+  std::set<std::string> seen;
+  for (const std::string& c : columns) {
+    for (const char* prefix : {"q_", "qm_"}) {
+      const std::string p(prefix);
+      if (c.size() <= p.size() || c.compare(0, p.size(), p) != 0) continue;
+      const std::string name = c.substr(p.size());
+      if (known.count(name) && seen.insert(name).second) named.push_back(name);
+    }
+  }
+  return named;
+}
+
 std::vector<Eigen::Index> resolve_joint_columns(const std::vector<std::string>& columns,
                                                 const std::vector<std::string>& joint_names,
                                                 const std::string& prefix,

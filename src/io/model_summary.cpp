@@ -4,6 +4,7 @@
 #include <cstdarg>
 #include <cstdio>
 
+#include "dynid/common/error.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/version.hpp"
 
@@ -36,6 +37,33 @@ void appendf(std::string& out, const char* format, ...) {
 }
 
 }  // namespace
+
+nlohmann::json locked_joints_to_json(const Model& model) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const JointLock& l : model.locked_joints)
+    out.push_back({{"name", l.name}, {"value", l.value}});
+  return out;
+}
+
+std::vector<JointLock> locked_joints_from_json(const nlohmann::json& result,
+                                               const std::string& path) {
+  std::vector<JointLock> out;
+  if (!result.is_object() || !result.contains("locked_joints")) return out;
+  const nlohmann::json& list = result["locked_joints"];
+  bool ok = list.is_array();
+  for (size_t i = 0; ok && i < list.size(); ++i) {
+    const nlohmann::json& e = list[i];
+    ok = e.is_object() && e.contains("name") && e["name"].is_string() && e.contains("value") &&
+         e["value"].is_number() && std::isfinite(e["value"].get<double>());
+    if (ok) out.push_back({e["name"].get<std::string>(), e["value"].get<double>()});
+  }
+  if (!ok) {
+    throw Error("'" + path +
+                "': locked_joints must be a list of {name, value} (as dynid writes it); give the "
+                "result file unedited");
+  }
+  return out;
+}
 
 nlohmann::json model_to_json(const Model& model) {
   using nlohmann::json;
@@ -84,6 +112,7 @@ nlohmann::json model_to_json(const Model& model) {
     offset.push_back(model.transmission.q_offset(r));
   }
   j["transmission"] = {{"N", rows}, {"q_offset", offset}};
+  j["locked_joints"] = locked_joints_to_json(model);
   j["version"] = kVersion;
   return j;
 }

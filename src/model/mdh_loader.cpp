@@ -346,7 +346,7 @@ void read_transmission(const YAML::Node& doc, const Ctx& ctx, Model& model) {
 }  // namespace
 
 Model parse_yaml_model(const std::string& yaml, const std::string& source,
-                       const std::string& base_dir) {
+                       const std::string& base_dir, std::vector<std::string>* warnings) {
   const Ctx ctx{source};
   YAML::Node doc;
   try {
@@ -361,6 +361,7 @@ Model parse_yaml_model(const std::string& yaml, const std::string& source,
   const bool urdf = has(doc, "urdf");
   if (mdh == urdf) ctx.fail("", "give exactly one of 'joints:' (MDH table) or 'urdf:' (file)");
   Model model;
+  bool from_urdf = false;
   try {
     if (mdh) {
       check_keys(doc, {"name", "joints", "base", "gravity", "transmission", "gear_ratios"}, ctx,
@@ -373,7 +374,10 @@ Model parse_yaml_model(const std::string& yaml, const std::string& source,
                  "");
       std::filesystem::path p = doc["urdf"].as<std::string>();
       if (p.is_relative()) p = std::filesystem::path(base_dir) / p;
-      model = load_urdf(p.string());
+      // The URDF's links are checked (and tolerated faults said) once, here: the YAML's friction,
+      // gravity and transmission change no link, so finalize() below does not say them again.
+      model = load_urdf(p.string(), warnings);
+      from_urdf = true;
       if (has(doc, "name")) model.name = doc["name"].as<std::string>();
       if (has(doc, "friction")) {
         const YAML::Node fr = doc["friction"];
@@ -407,13 +411,14 @@ Model parse_yaml_model(const std::string& yaml, const std::string& source,
     throw Error("robot file '" + source + "'" + line + ": " + reason + "; check the value's type");
   }
   model.source = source;
-  model.finalize();
+  std::vector<std::string> said_by_the_urdf;
+  model.finalize(from_urdf ? &said_by_the_urdf : warnings);
   return model;
 }
 
-Model load_yaml_model(const std::string& path) {
+Model load_yaml_model(const std::string& path, std::vector<std::string>* warnings) {
   const std::string text = read_robot_file(path);
-  return parse_yaml_model(text, path, std::filesystem::path(path).parent_path().string());
+  return parse_yaml_model(text, path, std::filesystem::path(path).parent_path().string(), warnings);
 }
 
 }  // namespace dynid

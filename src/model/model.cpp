@@ -9,6 +9,7 @@
 #include <Eigen/QR>
 
 #include "dynid/common/error.hpp"
+#include "dynid/common/message.hpp"
 
 namespace dynid {
 
@@ -60,10 +61,11 @@ bool all_finite(const Eigen::Ref<const Eigen::MatrixXd>& m) {
   return m.allFinite();
 }
 
-void check_physical(const LinkParams& p, const std::string& link) {
+void check_physical(const LinkParams& p, const std::string& link,
+                    std::vector<std::string>* warnings) {
   const double m = p(9);
   if (!(m >= 0.0)) {
-    throw Error("link '" + link + "' has negative mass " + std::to_string(m) +
+    throw Error("link '" + link + "' has negative mass " + short_number(m) +
                 " kg; give a mass >= 0 in its <inertial> block");
   }
   Eigen::Matrix3d I_C = inertia_about_origin(p);
@@ -77,15 +79,27 @@ void check_physical(const LinkParams& p, const std::string& link) {
   const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(I_C).eigenvalues();
   const double scale = std::max(1.0, ev.cwiseAbs().maxCoeff());
   const double tol = 1e-9 * scale;
-  const bool triangle =
-      ev(0) + ev(1) >= ev(2) - tol && ev(0) + ev(2) >= ev(1) - tol && ev(1) + ev(2) >= ev(0) - tol;
-  if (ev.minCoeff() < -tol || !triangle) {
-    std::ostringstream msg;
-    msg << "link '" << link << "' has a non-physical inertia (principal moments about the centre "
-        << "of mass " << ev.transpose()
-        << " must be >= 0 and satisfy the triangle inequality); fix its inertia tensor";
-    throw Error(msg.str());
+  // ev is sorted ascending: the triangle inequality binds on the largest moment only.
+  const double triangle_excess = ev(2) - ev(0) - ev(1);
+  if (ev.minCoeff() >= -tol && triangle_excess <= tol) return;
+  std::ostringstream what;
+  what << "link '" << link << "' has a non-physical inertia: principal moments about the centre "
+       << "of mass " << short_number(ev(0)) << ", " << short_number(ev(1)) << ", "
+       << short_number(ev(2)) << " kg m^2";
+  const double largest = std::max(ev.cwiseAbs().maxCoeff(), 1e-300);
+  if (ev.minCoeff() < -tol) {
+    what << " (one is negative: " << short_number(100.0 * -ev.minCoeff() / largest)
+         << " % of the largest)";
+  } else {
+    what << " break the triangle inequality (" << short_number(ev(2)) << " > "
+         << short_number(ev(0)) << " + " << short_number(ev(1)) << " by "
+         << short_number(100.0 * triangle_excess / ev(2)) << " %)";
   }
+  if (!warnings) {
+    throw Error(what.str() +
+                "; they must be >= 0 and satisfy the triangle inequality: fix its inertia tensor");
+  }
+  warnings->push_back(what.str() + "; loaded as it is (--strict refuses it)");
 }
 
 // Relative threshold of the invertibility test: smallest / largest pivot magnitude.
@@ -132,7 +146,7 @@ bool transmission_invertible(const Eigen::MatrixXd& N) {
 
 }  // namespace
 
-void Model::finalize() {
+void Model::finalize(std::vector<std::string>* inertia_warnings) {
   const int n = dof();
   if (n == 0)
     throw Error("model '" + name + "' has no moving joints; add a revolute or prismatic joint");
@@ -177,7 +191,7 @@ void Model::finalize() {
     }
     if (!links[j].allFinite())
       throw Error("link '" + jt.link_name + "' has non-finite inertial values");
-    check_physical(links[j], jt.link_name.empty() ? jt.name : jt.link_name);
+    check_physical(links[j], jt.link_name.empty() ? jt.name : jt.link_name, inertia_warnings);
   }
   if (transmission.N.size() == 0) transmission.N = Eigen::MatrixXd::Identity(n, n);
   if (transmission.q_offset.size() == 0) transmission.q_offset = Eigen::VectorXd::Zero(n);

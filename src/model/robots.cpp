@@ -47,7 +47,9 @@ std::vector<std::string> builtin_robot_names() {
   return names;
 }
 
-Model load_robot(const std::string& name_or_path) {
+namespace {
+
+Model load_robot_file(const std::string& name_or_path, std::vector<std::string>* warnings) {
   if (name_or_path.empty()) {
     throw Error("empty robot name; give a built-in name (" + join(builtin_robot_names()) +
                 ") or a path to a .urdf or .yaml file");
@@ -60,7 +62,7 @@ Model load_robot(const std::string& name_or_path) {
     for (const char* ext : {".yaml", ".yml", ".urdf"}) {
       const fs::path p = dir / (name_or_path + ext);
       if (fs::is_regular_file(p)) {
-        Model m = load_robot(p.string());
+        Model m = load_robot_file(p.string(), warnings);
         m.name = name_or_path;
         return m;
       }
@@ -69,10 +71,23 @@ Model load_robot(const std::string& name_or_path) {
                 join(builtin_robot_names()) + " (or give a path to a .urdf or .yaml file)");
   }
   const std::string ext = fs::path(name_or_path).extension().string();
-  if (ext == ".urdf") return load_urdf(name_or_path);
-  if (ext == ".yaml" || ext == ".yml") return load_yaml_model(name_or_path);
+  if (ext == ".urdf") return load_urdf(name_or_path, warnings);
+  if (ext == ".yaml" || ext == ".yml") return load_yaml_model(name_or_path, warnings);
   throw Error("robot file '" + name_or_path + "' has extension '" + ext +
               "'; use a .urdf or a .yaml/.yml file (or a built-in name)");
+}
+
+}  // namespace
+
+Model load_robot(const std::string& name_or_path) {
+  return load_robot_file(name_or_path, nullptr);
+}
+
+LoadedRobot load_robot(const std::string& name_or_path, const RobotOptions& options) {
+  LoadedRobot out;
+  out.model = lock_joints(load_robot_file(name_or_path, options.strict ? nullptr : &out.warnings),
+                          options.selection);
+  return out;
 }
 
 }  // namespace dynid

@@ -4,10 +4,12 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <unordered_set>
 #include <utility>
@@ -93,27 +95,112 @@ LinkParams urdf_link_params(const urdf::Link& link) {
   return link_params_from_com(in.mass, o.p, I_C);
 }
 
+/// True when `text` is `count` numbers separated by white space (strtod, the whole text).
+bool numbers_in(const char* text, int count) {
+  const char* p = text;
+  for (int k = 0; k < count; ++k) {
+    char* end = nullptr;
+    const double x = std::strtod(p, &end);
+    if (end == p || !std::isfinite(x)) return false;
+    p = end;
+  }
+  while (*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r') ++p;
+  return *p == '\0';
+}
+
+/// urdfdom reads a number it cannot parse in <inertial> (a leftover xacro `${l}`) as 0 without a
+/// word, so a link would load massless: every numeric attribute of every <inertial> is checked in
+/// the raw XML first. Throws dynid::Error naming the link, the element and the attribute.
+void check_inertial_numbers(const tinyxml2::XMLElement& robot, const std::string& source) {
+  struct Numeric {
+    const char* element;
+    const char* attribute;
+    int count;
+  };
+  static const Numeric kNumeric[] = {
+      {"origin", "xyz", 3},  {"origin", "rpy", 3},  {"mass", "value", 1},
+      {"inertia", "ixx", 1}, {"inertia", "ixy", 1}, {"inertia", "ixz", 1},
+      {"inertia", "iyy", 1}, {"inertia", "iyz", 1}, {"inertia", "izz", 1}};
+  for (const tinyxml2::XMLElement* link = robot.FirstChildElement("link"); link;
+       link = link->NextSiblingElement("link")) {
+    const tinyxml2::XMLElement* inertial = link->FirstChildElement("inertial");
+    if (!inertial) continue;
+    const char* name = link->Attribute("name");
+    for (const Numeric& n : kNumeric) {
+      const tinyxml2::XMLElement* e = inertial->FirstChildElement(n.element);
+      const char* text = e ? e->Attribute(n.attribute) : nullptr;
+      if (!text || numbers_in(text, n.count)) continue;
+      const std::string value = printable(text);
+      const bool xacro = value.find('$') != std::string::npos;
+      throw Error(
+          "link '" + printable(name ? name : "") + "' in '" + source + "': <inertial> <" +
+          n.element + " " + n.attribute + "=\"" + value + "\"> is not " +
+          (n.count == 1 ? "a number" : std::to_string(n.count) + " numbers") +
+          (xacro ? " (a xacro expression left unexpanded: run xacro on the file first)" : "") +
+          "; write the value as a number");
+    }
+  }
+}
+
 /// Joint names in the order of their <joint> elements in the file (urdfdom keeps its child_joints
 /// in a std::map order, i.e. sorted by name, so the file order is read separately).
-std::map<std::string, int> joint_file_order(const std::string& xml, const std::string& source) {
+/// What the raw XML says before urdfdom reads it: the joints' file order (urdfdom keeps its
+/// child_joints sorted by name) and, when a <limit> had to be completed, the text to parse.
+struct RawUrdf {
+  std::map<std::string, int> order;
+  std::optional<std::string> completed;  ///< the XML with missing limit attributes set
+};
+
+/// Reads the XML with tinyxml2: checks the <inertial> numbers (check_inertial_numbers), records
+/// the joint order, and completes a <limit> without effort or velocity (urdfdom refuses it,
+/// "joint limit: no effort", and URDFs written back by other tools omit them): with `warnings`
+/// the attribute is set to 0, which dynid reads as unlimited, and a warning names the joint;
+/// without, it is an error naming the joint.
+RawUrdf read_raw_urdf(const std::string& xml, const std::string& source,
+                      std::vector<std::string>* warnings) {
   tinyxml2::XMLDocument doc;
   if (doc.Parse(xml.c_str(), xml.size()) != tinyxml2::XML_SUCCESS) {
     const std::string detail = printable(doc.ErrorStr() ? doc.ErrorStr() : "unknown error");
     throw Error("robot file '" + source + "' is not well-formed XML (" + detail +
                 "); fix the XML syntax");
   }
-  const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
+  tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
   if (!robot) {
     throw Error("robot file '" + source + "' has no <robot> element; it must be a URDF file");
   }
-  std::map<std::string, int> order;
+  check_inertial_numbers(*robot, source);
+  RawUrdf out;
   int k = 0;
-  for (const tinyxml2::XMLElement* e = robot->FirstChildElement("joint"); e;
+  bool completed = false;
+  for (tinyxml2::XMLElement* e = robot->FirstChildElement("joint"); e;
        e = e->NextSiblingElement("joint")) {
     const char* name = e->Attribute("name");
-    if (name) order.emplace(name, k++);
+    if (name) out.order.emplace(name, k++);
+    tinyxml2::XMLElement* limit = e->FirstChildElement("limit");
+    if (!limit) continue;
+    std::string missing;
+    for (const char* attribute : {"effort", "velocity"}) {
+      if (limit->Attribute(attribute)) continue;
+      missing += (missing.empty() ? "" : " and ") + std::string(attribute);
+      limit->SetAttribute(attribute, "0");
+    }
+    if (missing.empty()) continue;
+    const std::string what = "joint '" + printable(name ? name : "") + "' in '" + source +
+                             "' has a <limit> without " + missing;
+    if (!warnings) {
+      throw Error(what +
+                  " (the URDF format requires both); add them (dynid reads such a joint "
+                  "as unlimited unless --strict)");
+    }
+    warnings->push_back(what + "; read as unlimited (--strict refuses it)");
+    completed = true;
   }
-  return order;
+  if (completed) {
+    tinyxml2::XMLPrinter printer;
+    doc.Print(&printer);
+    out.completed = std::string(printer.CStr());
+  }
+  return out;
 }
 
 const char* type_name(int type) {
@@ -279,13 +366,15 @@ class TreeBuilder {
 
 }  // namespace
 
-Model parse_urdf(const std::string& xml, const std::string& source) {
-  const std::map<std::string, int> order = joint_file_order(xml, source);
+Model parse_urdf(const std::string& xml, const std::string& source,
+                 std::vector<std::string>* warnings) {
+  const RawUrdf raw = read_raw_urdf(xml, source, warnings);
+  const std::map<std::string, int>& order = raw.order;
   urdf::ModelInterfaceSharedPtr urdf;
   std::string urdfdom_message;
   {
     const ConsoleCapture capture;  // urdfdom reports through console_bridge: keep it off stderr
-    urdf = urdf::parseURDF(xml);
+    urdf = urdf::parseURDF(raw.completed ? *raw.completed : xml);
     urdfdom_message = capture.first_error();
   }
   if (!urdf) {
@@ -305,12 +394,14 @@ Model parse_urdf(const std::string& xml, const std::string& source) {
     throw Error("robot file '" + source +
                 "' has no revolute, continuous or prismatic joint; add a moving joint");
   }
-  model.finalize();
+  model.finalize(warnings);
   return model;
 }
 
-Model load_urdf(const std::string& path) {
-  return parse_urdf(read_robot_file(path), path);
+Model load_urdf(const std::string& path, std::vector<std::string>* warnings) {
+  Model model = parse_urdf(read_robot_file(path), path, warnings);
+  model.urdf = path;
+  return model;
 }
 
 }  // namespace dynid

@@ -14,6 +14,7 @@
 
 #include "dynid/common/error.hpp"
 #include "dynid/common/input_file.hpp"
+#include "dynid/io/model_summary.hpp"
 #include "dynid/io/urdf_writer.hpp"
 #include "dynid/model/urdf_loader.hpp"
 #include "dynid/version.hpp"
@@ -134,6 +135,7 @@ ConsistentParameterFile read_consistent_parameters(const std::string& path) {
         if (name.is_string()) out.joints.push_back(name.get<std::string>());
     }
   }
+  out.locked_joints = locked_joints_from_json(j, path);
   return out;
 }
 
@@ -230,14 +232,18 @@ UrdfExport export_urdf(const Model& nominal, const std::vector<std::string>& nam
                               number(nominal.gravity.y()) + ", " + number(nominal.gravity.z()) +
                               ") m/s^2 (URDF has no gravity; set it in the simulator)");
   }
-  const bool edit = ends_with(nominal.source, ".urdf");
-  const std::string xml = edit ? read_robot_file(nominal.source) : to_urdf(out.model);
+  // The URDF the frames came from: a .urdf model's own file, or the one a YAML model names.
+  const std::string urdf = !nominal.urdf.empty()                ? nominal.urdf
+                           : ends_with(nominal.source, ".urdf") ? nominal.source
+                                                                : std::string();
+  const bool edit = !urdf.empty();
+  const std::string xml = edit ? read_robot_file(urdf) : to_urdf(out.model);
   tinyxml2::XMLDocument doc;
   if (doc.Parse(xml.c_str(), xml.size()) != tinyxml2::XML_SUCCESS) {
-    throw Error("cannot parse URDF '" + nominal.source + "' (" + doc.ErrorStr() + ")");
+    throw Error("cannot parse URDF '" + urdf + "' (" + doc.ErrorStr() + ")");
   }
   tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
-  if (!robot) throw Error("URDF '" + nominal.source + "' has no <robot> element");
+  if (!robot) throw Error("URDF '" + urdf + "' has no <robot> element");
   if (edit) {
     std::map<std::string, tinyxml2::XMLElement*> links, joints;
     std::multimap<std::string, std::string> fixed_children;  // parent link -> child link
@@ -252,20 +258,24 @@ UrdfExport export_urdf(const Model& nominal, const std::vector<std::string>& nam
     for (auto* e = robot->FirstChildElement("joint"); e; e = e->NextSiblingElement("joint")) {
       if (const char* name = e->Attribute("name")) joints[name] = e;
       const char* type = e->Attribute("type");
-      if (type && std::string(type) == "fixed")
+      const char* name = e->Attribute("name");
+      // A joint held during identification (Model::locked_joints) was merged like a fixed one.
+      const bool locked =
+          name && std::any_of(nominal.locked_joints.begin(), nominal.locked_joints.end(),
+                              [name](const JointLock& l) { return l.name == name; });
+      if ((type && std::string(type) == "fixed") || locked)
         fixed_children.emplace(link_of(e, "parent"), link_of(e, "child"));
     }
     for (int j = 0; j < n; ++j) {
       const Joint& joint = nominal.joints[static_cast<size_t>(j)];
       const auto it = joints.find(joint.name);
       if (it == joints.end()) {
-        throw Error("joint '" + joint.name + "' of the model is not in URDF '" + nominal.source +
-                    "'");
+        throw Error("joint '" + joint.name + "' of the model is not in URDF '" + urdf + "'");
       }
       const std::string child = link_of(it->second, "child");
       if (!links.count(child)) {
-        throw Error("link '" + child + "' of joint '" + joint.name + "' is not in URDF '" +
-                    nominal.source + "'");
+        throw Error("link '" + child + "' of joint '" + joint.name + "' is not in URDF '" + urdf +
+                    "'");
       }
       set_inertial(doc, links[child], out.model.links[static_cast<size_t>(j)]);
       // Links rigidly attached to this one were merged into it by the loader, so the identified
@@ -299,6 +309,11 @@ UrdfExport export_urdf(const Model& nominal, const std::vector<std::string>& nam
   note << " Identified by dynid " << kVersion << " from '" << origin
        << "': physically consistent inertials";
   if (edit) note << " and joint <dynamics> replaced, every other element kept";
+  if (!nominal.locked_joints.empty()) {
+    note << ". Joints held during identification (their links' inertia is in the moving parent's):";
+    for (const JointLock& l : nominal.locked_joints)
+      note << ' ' << l.name << '=' << number(l.value);
+  }
   if (!out.merged_links.empty()) {
     note << ". Links merged into their moving parent (inertial removed):";
     for (const auto& l : out.merged_links) note << ' ' << l;

@@ -295,6 +295,15 @@ Json identify_section(const ReportInput& in) {
   if (r.contains("model") && r["model"].is_object()) {
     add_fact(s, "robot", text_of(r["model"].value("name", Json("?"))));
   }
+  if (r.contains("locked_joints") && r["locked_joints"].is_array() && !r["locked_joints"].empty()) {
+    std::string locked;
+    for (const Json& l : r["locked_joints"]) {
+      if (!l.is_object()) continue;
+      locked += (locked.empty() ? "" : ", ") + text_of(l.value("name", Json("?"))) + " = " +
+                text_of(l.value("value", Json()));
+    }
+    add_fact(s, "locked joints (held, not identified)", locked);
+  }
   add_fact(s, "estimator", text_of(r.value("estimator", Json())));
   add_fact(s, "samples / equations",
            text_of(r.value("samples", Json())) + " / " + text_of(r.value("rows", Json())));

@@ -14,6 +14,7 @@
 #include "dynid/common/message.hpp"
 #include "dynid/io/csv_writer.hpp"
 #include "dynid/io/json_writer.hpp"
+#include "dynid/io/model_summary.hpp"
 #include "dynid/version.hpp"
 
 namespace dynid {
@@ -109,6 +110,7 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
                           {"source", model.source},
                           {"dof", model.dof()},
                           {"joints", joint_names(model)}}},
+                        {"locked_joints", locked_joints_to_json(model)},
                         {"parameters", params},
                         {"covariance_matrix", rows(e.covariance)},
                         {"data_regrouping",
@@ -278,6 +280,7 @@ IdentifiedResultFile identification_result_from_json(const nlohmann::json& j,
       }
     }
   }
+  out.locked_joints = locked_joints_from_json(j, path);
   const auto threshold = j.find("zero_velocity_threshold");
   if (threshold != j.end() && threshold->is_array()) {
     for (const auto& x : *threshold) {

@@ -5,8 +5,6 @@
 // Oracle: a planar2 run generated here from the closed form of docs/methods/model.md (not by
 // dynid): its torques are predicted exactly by the true parameters, so a run read the right way
 // validates to round-off and one read the wrong way does not.
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -18,7 +16,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "support/cli_run.hpp"
+#include "support/cli_fixture.hpp"
 #include "support/planar2.hpp"
 
 namespace {
@@ -37,20 +35,8 @@ Sample planar2_sample(int k) {
   return dynid::testing::planar2_sample(k, kDt);
 }
 
-class RunFlagsCli : public ::testing::Test {
+class RunFlagsCli : public dynid::testing::CliScratchTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("dynid_runflags_" + std::to_string(::getpid()) + "_" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  CliRun run(const std::string& args) const { return dynid::testing::run_dynid(args, dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-
   // A run t,q1,q2,dq1,dq2,ddq1,ddq2,tau1,tau2 (the names in `header`, t left out when `time` is
   // false); logged torque j = tau_j / scale_j + bias_j; t multiplied by `time_unit`.
   std::string write_run(const std::string& name, const std::vector<std::string>& header,
@@ -79,13 +65,6 @@ class RunFlagsCli : public ::testing::Test {
       if (p["name"] == "ZZ1R") return p["value"].get<double>();
     return NAN;
   }
-  static void expect_error(const CliRun& r, int code, const std::vector<std::string>& parts) {
-    EXPECT_EQ(r.code, code) << r.err;
-    EXPECT_EQ(dynid::testing::error_contract_problem(r.err), "") << r.err;
-    for (const auto& part : parts)
-      EXPECT_NE(r.err.find(part), std::string::npos) << r.err << "\nexpected: " << part;
-  }
-
   const std::vector<std::string> kStandard = {"t",    "q1",   "q2",   "dq1", "dq2",
                                               "ddq1", "ddq2", "tau1", "tau2"};
   // A recorder's own names: no t column, positions, velocities and currents named otherwise.
@@ -93,7 +72,6 @@ class RunFlagsCli : public ::testing::Test {
                                             "acc1", "acc2", "cur1", "cur2"};
   const std::string kVendorColumns =
       "pos1=q1,pos2=q2,vel1=dq1,vel2=dq2,acc1=ddq1,acc2=ddq2,cur1=tau1,cur2=tau2";
-  fs::path dir_;
 };
 
 // The help line of `flag` in `help` (CLI11 prints one line per flag and its description).

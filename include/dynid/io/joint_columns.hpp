@@ -38,6 +38,12 @@ std::vector<Eigen::Index> resolve_joint_columns(const std::vector<std::string>& 
 bool has_joint_columns(const std::vector<std::string>& columns,
                        const std::vector<std::string>& joint_names, const std::string& prefix);
 
+/// The joints of `joint_names` that the header names by a `q_<joint name>` or `qm_<joint name>`
+/// column, in header order, each once; empty when it names none (issue 26 item 1: a log of some of
+/// a robot file's joints is matched to it by name).
+std::vector<std::string> joints_named_in_columns(const std::vector<std::string>& columns,
+                                                 const std::vector<std::string>& joint_names);
+
 /// The samples × n matrix of signal `prefix` in joint order (resolve_joint_columns on the table).
 Eigen::MatrixXd joint_signal(const CsvTable& table, const std::vector<std::string>& joint_names,
                              const std::string& prefix);

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -37,12 +38,14 @@ Joint mdh_joint(const MdhRow& row);
 /// Both accept `name`, `gravity: [gx, gy, gz]` (base frame, m/s²), and either
 /// `transmission: {N: n×n rows, q_offset: [n]}` or `gear_ratios: [n]` (N = diag).
 /// Throws dynid::Error naming the key and row at fault (missing key, unknown key, NaN/Inf, wrong
-/// sizes, negative mass) and every error of Model::finalize / load_urdf.
-Model load_yaml_model(const std::string& path);
+/// sizes, negative mass) and every error of Model::finalize / load_urdf; a non-physical inertia
+/// is a line of `warnings` when it is not null (Model::finalize). Model::urdf is the
+/// `urdf:` file, resolved.
+Model load_yaml_model(const std::string& path, std::vector<std::string>* warnings = nullptr);
 
 /// Same as load_yaml_model for YAML text; `source` names it in messages and Model::source, and a
 /// relative `urdf:` path is resolved against `base_dir`.
 Model parse_yaml_model(const std::string& yaml, const std::string& source,
-                       const std::string& base_dir);
+                       const std::string& base_dir, std::vector<std::string>* warnings = nullptr);
 
 }  // namespace dynid

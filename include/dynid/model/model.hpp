@@ -66,6 +66,12 @@ struct Transmission {
   bool is_identity() const;
 };
 
+/// A moving joint of the robot file held fixed at a value (lock_joints(), issue 26 item 1).
+struct JointLock {
+  std::string name;    ///< the joint's name in the robot file
+  double value = 0.0;  ///< the position it is held at [rad or m]
+};
+
 /// An immutable kinematic tree with inertial, actuator and friction parameters. Built by the
 /// loaders (URDF, MDH YAML) or by hand followed by finalize(); every algorithm takes it by const&.
 /// Joint order is the index j used everywhere (columns, parameter names): parents precede children.
@@ -76,6 +82,11 @@ struct Model {
   Eigen::Vector3d gravity{0.0, 0.0, -9.81};  ///< in the base frame [m/s²]
   Transmission transmission;
   std::string source;  ///< file or built-in name it came from
+  /// The URDF file the frames were read from (a .urdf model, or the `urdf:` of a YAML model);
+  /// empty for MDH tables. export edits this file, so its <visual> and meshes are kept.
+  std::string urdf;
+  /// Moving joints of the robot file held fixed (lock_joints()), in file order; empty: none.
+  std::vector<JointLock> locked_joints;
 
   int dof() const { return static_cast<int>(joints.size()); }
 
@@ -84,8 +95,12 @@ struct Model {
   /// semi-definite with the triangle inequality), the joint count (at most kMaxJoints), duplicate
   /// joint names, and an invertible transmission (scale-invariant test, linear time for a diagonal
   /// N) and fills defaults (identity transmission). Throws dynid::Error naming the joint or link at
-  /// fault.
-  void finalize();
+  /// fault. A link inertia that is not physical (an inertia about the centre of mass that is not
+  /// positive semi-definite or breaks the triangle inequality) is an error when
+  /// `inertia_warnings` is null, else one line appended to it (naming the link and the size of
+  /// the violation) and the model is kept: vendor URDFs break it by a few percent. A negative mass
+  /// and a first moment without mass stay errors.
+  void finalize(std::vector<std::string>* inertia_warnings = nullptr);
 
   /// The standard parameter vector theta (10 per link, docs/design.md section 3 order), size 10·n.
   Eigen::VectorXd standard_parameters() const;

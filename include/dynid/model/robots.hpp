@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "dynid/model/joint_lock.hpp"
 #include "dynid/model/model.hpp"
 
 namespace dynid {
@@ -21,5 +22,23 @@ std::vector<std::string> builtin_robot_names();
 /// Model::source is the file that was read. Throws dynid::Error for an unknown built-in (the
 /// message lists the built-in names), an unsupported extension, and every loader error.
 Model load_robot(const std::string& name_or_path);
+
+/// How a robot is loaded for a run (the CLI's --joints, --lock, --strict; Python's load_model).
+struct RobotOptions {
+  JointSelection selection;  ///< joints identified and joints locked (lock_joints); empty: all
+  /// false (default): a non-physical link inertia loads with a warning (vendor URDFs break the
+  /// triangle inequality by a few percent); true: it is an error.
+  bool strict = false;
+};
+
+/// A loaded robot and what loading it said.
+struct LoadedRobot {
+  Model model;  ///< finalized, with the selection applied (Model::locked_joints)
+  std::vector<std::string> warnings;  ///< one line per non-physical link inertia tolerated
+};
+
+/// load_robot(name_or_path) with `options`: the inertia check as options.strict says, then
+/// lock_joints(model, options.selection). Throws as load_robot and lock_joints.
+LoadedRobot load_robot(const std::string& name_or_path, const RobotOptions& options);
 
 }  // namespace dynid

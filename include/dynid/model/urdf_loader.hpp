@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "dynid/model/model.hpp"
 
@@ -9,8 +10,8 @@ namespace dynid {
 
 /// Reads a URDF file and builds a finalized Model (see parse_urdf for the mapping).
 /// Throws dynid::Error "cannot open robot file '<path>'" when the file cannot be read, and every
-/// error of parse_urdf.
-Model load_urdf(const std::string& path);
+/// error of parse_urdf. Model::urdf is `path`.
+Model load_urdf(const std::string& path, std::vector<std::string>* warnings = nullptr);
 
 /// Builds a finalized Model from URDF text; `source` names the text in error messages and is stored
 /// in Model::source. Mapping (docs/methods/model.md, "URDF"):
@@ -25,9 +26,14 @@ Model load_urdf(const std::string& path);
 /// - <inertial> with origin xyz/rpy: I = R·I_in·Rᵀ, then the parallel-axis theorem
 ///   (link_params_from_com, seed 1 eq. 24). <dynamics damping friction> -> Fv, Fc.
 /// - <limit lower upper velocity effort>; a velocity or effort of 0 (unset) means unlimited.
-/// Throws dynid::Error for malformed XML, unsupported joint types (floating, planar), a robot with
-/// no moving joint, and every check of Model::finalize (non-physical inertia, ...).
-Model parse_urdf(const std::string& xml, const std::string& source);
+/// Throws dynid::Error for malformed XML, an <inertial> value that is not a number (a leftover
+/// xacro `${l}`, which urdfdom would read as 0; the message names the link), unsupported joint
+/// types (floating, planar), a robot with no moving joint, and every check of Model::finalize. A
+/// non-physical inertia is an error when `warnings` is null, else a line appended to it
+/// (Model::finalize); so is a <limit> without effort or velocity (which URDFs written back by
+/// other tools omit and urdfdom refuses), read as unlimited when tolerated.
+Model parse_urdf(const std::string& xml, const std::string& source,
+                 std::vector<std::string>* warnings = nullptr);
 
 /// Largest robot description file (URDF or YAML) read_robot_file accepts [bytes]; docs/cli.md.
 inline constexpr std::size_t kMaxRobotFileBytes = std::size_t{64} << 20;

@@ -15,6 +15,7 @@ struct ConsistentParameterFile {
   Eigen::VectorXd values;           ///< `standard_parameters[].value`, SI units
   std::string robot;                ///< `model.name`; empty when the file has none
   std::vector<std::string> joints;  ///< `model.joints`; empty when the file has none
+  std::vector<JointLock> locked_joints;  ///< `locked_joints`: joints identify held fixed
 };
 
 /// Reads `standard_parameters` of a result JSON. Throws dynid::Error naming the file when it cannot

@@ -32,6 +32,8 @@ struct IdentifiedResultFile {
   nlohmann::json options;           ///< `options` as given to identify (empty object if absent)
   std::string robot;                ///< `model.name`; empty when the file has none
   std::vector<std::string> joints;  ///< `model.joints`; empty when the file has none
+  /// `locked_joints`: the robot file's joints identify held fixed (empty: none, or an older file).
+  std::vector<JointLock> locked_joints;
   /// `zero_velocity_threshold` per joint as identify used it; empty in files written before it
   /// was stored.
   std::vector<double> zero_velocity_threshold;
