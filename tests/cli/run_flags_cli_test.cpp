@@ -24,15 +24,15 @@ namespace {
 namespace fs = std::filesystem;
 using CliRun = dynid::testing::CliResult;
 
-constexpr int kSamples = 1500;
-constexpr double kDt = 0.01;
+constexpr int kRunFlagSamples = 1500;
+constexpr double kRunFlagDt = 0.01;
 // ZZ1R = ZZ1 + l1²·M2 of the closed-form arm: I1 + m1·c1² + m2·l1².
-constexpr double kZz1r = 2.0 / 12 + 2.0 * 0.25 + 1.5;
+constexpr double kRunFlagZz1r = 2.0 / 12 + 2.0 * 0.25 + 1.5;
 
 using Sample = dynid::testing::Planar2Sample;
 
 Sample planar2_sample(int k) {
-  return dynid::testing::planar2_sample(k, kDt);
+  return dynid::testing::planar2_sample(k, kRunFlagDt);
 }
 
 class RunFlagsCli : public dynid::testing::CliScratchTest {
@@ -46,7 +46,7 @@ class RunFlagsCli : public dynid::testing::CliScratchTest {
     f.precision(17);
     for (std::size_t c = time ? 0 : 1; c < header.size(); ++c)
       f << header[c] << (c + 1 < header.size() ? "," : "\n");
-    for (int k = 0; k < kSamples; ++k) {
+    for (int k = 0; k < kRunFlagSamples; ++k) {
       const Sample s = planar2_sample(k);
       if (time) f << s.t * time_unit << ',';
       f << s.q[0] << ',' << s.q[1] << ',' << s.dq[0] << ',' << s.dq[1] << ',' << s.ddq[0] << ','
@@ -120,7 +120,7 @@ TEST_F(RunFlagsCli, ValidateReadsTheRunAsIdentifyDid) {
       run("identify --robot planar2 --data " + data + " --rate 100 --columns " + kVendorColumns +
           " --torque-scale 2 --filter none --friction none --no-armature --out " + result);
   ASSERT_EQ(id.code, 0) << id.err;
-  EXPECT_NEAR(zz1r(load(result)), kZz1r, 1e-4);
+  EXPECT_NEAR(zz1r(load(result)), kRunFlagZz1r, 1e-4);
   const std::string val = path("val.json");
   const CliRun v =
       run("validate --robot planar2 --params " + result + " --data " + data + " --json " + val);
@@ -190,7 +190,7 @@ TEST_F(RunFlagsCli, TorqueBiasIsSubtractedFromTheLoggedTorque) {
   for (const std::string bias : {"1=0.7", "1=0.7,2=0", "shoulder=0.7", "elbow=0,shoulder=0.7"}) {
     const CliRun id = run(base + " --torque-bias " + bias);
     ASSERT_EQ(id.code, 0) << bias << id.err;
-    EXPECT_NEAR(zz1r(load(result)), kZz1r, 1e-4) << bias;
+    EXPECT_NEAR(zz1r(load(result)), kRunFlagZz1r, 1e-4) << bias;
     EXPECT_NE(id.err.find("torque bias"), std::string::npos) << id.err;
     EXPECT_EQ(load(result)["options"]["torque_bias"], bias);
   }
@@ -202,7 +202,7 @@ TEST_F(RunFlagsCli, TorqueBiasIsSubtractedFromTheLoggedTorque) {
   EXPECT_NE(v.err.find("--torque-bias as given to identify"), std::string::npos) << v.err;
   EXPECT_LT(load(path("val.json"))["relative_error_all_rows"].get<double>(), 1e-6);
   ASSERT_EQ(run(base).code, 0);
-  EXPECT_GT(std::abs(zz1r(load(result)) - kZz1r), 1e-3);
+  EXPECT_GT(std::abs(zz1r(load(result)) - kRunFlagZz1r), 1e-3);
   const std::string x = "identify --robot planar2 --data " + data + " --out " + path("x.json");
   expect_error(run(x + " --torque-bias 3=1"), 2, {"--torque-bias", "1 to 2"});
   expect_error(run(x + " --torque-bias wrist=1"), 2,

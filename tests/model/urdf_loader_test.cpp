@@ -373,7 +373,7 @@ TEST(UrdfLoaderErrors, DeviceWithoutEndIsCutAtTheSizeLimit) {
 // link and the violation; without a warning list (the --strict path) it is refused.
 TEST(UrdfLoaderTolerance, TriangleViolationOfAFewPercentIsAWarning) {
   std::vector<std::string> warnings;
-  const Model m = load_urdf(kData + "vendor_triangle.urdf", &warnings);
+  const Model m = load_urdf(kModelsDir + "vendor_triangle.urdf", &warnings);
   EXPECT_EQ(m.dof(), 2);
   ASSERT_EQ(warnings.size(), 1u);
   // 0.0206 > 0.01 + 0.01 by 0.0006 / 0.0206 = 2.913 %.
@@ -384,20 +384,20 @@ TEST(UrdfLoaderTolerance, TriangleViolationOfAFewPercentIsAWarning) {
       << warnings[0];
   // The inertia is kept as given: ZZ2 about the origin = 0.0206 + 0.8 * 0.05^2.
   EXPECT_NEAR(m.links[1](5), 0.0206 + 0.8 * 0.0025, 1e-15);
-  const std::string msg = error_of([] { load_urdf(kData + "vendor_triangle.urdf"); });
+  const std::string msg = error_of([] { load_urdf(kModelsDir + "vendor_triangle.urdf"); });
   EXPECT_NE(msg.find("link 'wrist' has a non-physical inertia"), std::string::npos) << msg;
 }
 
 TEST(UrdfLoaderTolerance, GrossViolationIsStillNamedWithItsSize) {
   std::vector<std::string> warnings;
-  load_urdf(kData + "triangle.urdf", &warnings);
+  load_urdf(kModelsDir + "triangle.urdf", &warnings);
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("(0.5 > 0.1 + 0.1 by 60 %)"), std::string::npos) << warnings[0];
 }
 
 TEST(UrdfLoaderTolerance, IdentificationToolStyleLoads) {
   std::vector<std::string> warnings;
-  const Model m = load_urdf(kData + "figaroh_style.urdf", &warnings);
+  const Model m = load_urdf(kModelsDir + "figaroh_style.urdf", &warnings);
   ASSERT_EQ(m.dof(), 2);
   EXPECT_EQ(m.joints[0].friction.Fv, 0.12);
   EXPECT_EQ(m.joints[0].friction.Fc, 0.3);
@@ -413,12 +413,12 @@ TEST(UrdfLoaderTolerance, IdentificationToolStyleLoads) {
   EXPECT_NE(warnings[1].find("one is negative: 0.07 % of the largest"), std::string::npos)
       << warnings[1];
   // Strict: the limit is refused first, naming the joint.
-  const std::string msg = error_of([] { load_urdf(kData + "figaroh_style.urdf"); });
+  const std::string msg = error_of([] { load_urdf(kModelsDir + "figaroh_style.urdf"); });
   EXPECT_NE(msg.find("joint 'joint_2'"), std::string::npos) << msg;
 }
 
 TEST(UrdfLoaderErrors, UnexpandedXacroInInertialNamesTheLink) {
-  const std::string msg = error_of([] { load_urdf(kData + "xacro_leftover.urdf"); });
+  const std::string msg = error_of([] { load_urdf(kModelsDir + "xacro_leftover.urdf"); });
   EXPECT_NE(msg.find("link 'forearm'"), std::string::npos) << msg;
   EXPECT_NE(msg.find("<origin xyz=\"${l/2} 0 0\"> is not 3 numbers"), std::string::npos) << msg;
   EXPECT_NE(msg.find("xacro"), std::string::npos) << msg;
