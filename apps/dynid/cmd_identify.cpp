@@ -61,6 +61,7 @@ struct IdentifyCliOptions {
   bool stream = false;
   int threads = 0;
   bool filter_coulomb = false;
+  std::vector<double> coulomb_width;  // --coulomb-width
   std::string outliers = "report";
   std::string model = "differential";  // --model
   double interval = 0.01;              // --interval (integral model)
@@ -162,6 +163,7 @@ IdentifyOptions library_options(const IdentifyCliOptions& o) {
   out.signal.savitzky_golay = o.savgol;
   out.signal.torque_time_offset = o.run.shift();
   out.signal.filter_coulomb_columns = o.filter_coulomb;
+  out.signal.coulomb_width = o.coulomb_width;
   if (o.outliers != "report" && o.outliers != "drop") {
     throw UsageError("--outliers must be report or drop, not '" + o.outliers + "'");
   }
@@ -216,6 +218,7 @@ nlohmann::json echo(const IdentifyCliOptions& o) {
           {"torque_offset_s", o.run.shift()},  // the old name of time_shift_s
           {"time_shift_s", o.run.shift()},
           {"filter_coulomb_columns", o.filter_coulomb},
+          {"coulomb_width", o.coulomb_width},
           {"outliers", o.outliers},
           {"model", o.model},
           {"columns", o.run.columns},
@@ -262,6 +265,12 @@ void add_signal_flags(CLI::App* cmd, IdentifyCliOptions& o) {
   cmd->add_flag("--filter-coulomb", o.filter_coulomb,
                 "Filter the sign(dq) columns like tau (parallel filtering): unbiased Fv and Fc "
                 "when the filter smears the Coulomb step at reversals");
+  cmd->add_option("--coulomb-width", o.coulomb_width,
+                  "Transition velocity v_c [rad/s] of the smooth Coulomb law "
+                  "Fc*erf(dq/(sqrt(2) v_c)) in the filtered Coulomb columns (1 or n values); "
+                  "default 0: the expected sign of the noisy velocity. With --zero-velocity 0 it "
+                  "keeps every row and models the pre-sliding band instead (docs/methods)")
+      ->delimiter(',');
 }
 
 // One warning per option that has no effect in the combination given.

@@ -26,6 +26,7 @@ const SignRule kSignRules[] = {
     {"identify", "--decimate", Sign::kNonNegative},
     {"identify", "--rate", Sign::kNonNegative},
     {"identify", "--zero-velocity", Sign::kNonNegative},
+    {"identify", "--coulomb-width", Sign::kNonNegative},
     {"identify", "--threads", Sign::kNonNegative},
     {"simulate", "--wrench-noise", Sign::kNonNegative},
     {"validate", "--cutoff", Sign::kNonNegative},

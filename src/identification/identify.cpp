@@ -183,6 +183,8 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
       SignalOptions signal = options.signal;
       if (signal.cutoff_hz <= 0.0) signal.cutoff_hz = integral_signal_options().cutoff_hz;
       if (signal.decimate <= 0) signal.decimate = 1;
+      // The friction work ∫|q̇| dt is continuous through rest: no pre-sliding band is modelled.
+      if (signal.coulomb_width.empty()) signal.coulomb_width_fraction = 0.0;
       processed = preprocess_run(model, screened.back().record, signal, choices);
       hold_still_joints(model, processed, choices);
       blocks.push_back(
@@ -207,6 +209,11 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
     result.samples += run.samples;
     // Validation leaves out the rows below the largest threshold any run used.
     result.zero_velocity_threshold = result.zero_velocity_threshold.cwiseMax(threshold);
+    if (processed.coulomb_width.size() == n) {
+      result.coulomb_width = result.coulomb_width.size() == n
+                                 ? result.coulomb_width.cwiseMax(processed.coulomb_width)
+                                 : processed.coulomb_width;
+    }
     const std::string prefix = runs.size() > 1 ? "run " + std::to_string(i + 1) + " " : "";
     for (auto& [key, value] : choices) result.choices.emplace_back(prefix + key, value);
     if (ml) prepared.push_back(processed);

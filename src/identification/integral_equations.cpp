@@ -301,6 +301,7 @@ SignalOptions integral_signal_options() {
   SignalOptions o;
   o.cutoff_hz = 10.0;
   o.decimate = 1;
+  o.coulomb_width_fraction = 0.0;  // ∫|q̇| is continuous at rest: no band to model
   return o;
 }
 

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <iomanip>
 #include <sstream>
+#include <tuple>
+#include <utility>
 
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
@@ -125,7 +127,8 @@ Eigen::MatrixXd stacked_regressor(const Model& model, const ParameterLayout& lay
 }
 
 ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& options,
-                           std::vector<std::pair<std::string, std::string>>& choices) {
+                           std::vector<std::pair<std::string, std::string>>& choices,
+                           const Eigen::MatrixXd& coupled_rows) {
   const int n = static_cast<int>(input.q.cols());
   check_signal_options(options);
   check_record(input, n);
@@ -269,34 +272,93 @@ ProcessedRecord preprocess(const JointRecord& input, const SignalOptions& option
   out.position_noise_std =
       floor.noise_std.unaryExpr([](double v) { return std::isfinite(v) ? v : 0.0; });
   out.velocity_noise_std = out_noise_gain * out.position_noise_std;
-  if (options.filter && (options.filter_coulomb_columns || options.zero_velocity.empty())) {
-    // Expected sign of the true velocity given the noisy one (Gaussian noise σ_dq, flat prior):
-    // E[sign(dq)] = erf(dq̂/(√2σ)); its halves are the moving-positive/-negative indicators.
-    Eigen::MatrixXd pos(r.dq.rows(), r.dq.cols()), neg(r.dq.rows(), r.dq.cols());
-    for (Eigen::Index j = 0; j < r.dq.cols(); ++j) {
-      const double sigma = out.velocity_noise_std[j];
-      for (Eigen::Index k = 0; k < r.dq.rows(); ++k) {
-        const double v = r.dq(k, j);
-        const double s = sigma > 0.0 ? std::erf(v / (std::sqrt(2.0) * sigma))
-                                     : static_cast<double>((v > 0.0) - (v < 0.0));
-        pos(k, j) = sigma > 0.0 ? 0.5 * (1.0 + s) : static_cast<double>(v > 0.0);
-        neg(k, j) = sigma > 0.0 ? 0.5 * (1.0 - s) : static_cast<double>(v < 0.0);
+  if (options.filter && (options.filter_coulomb_columns || options.zero_velocity.empty() ||
+                         !options.coulomb_width.empty())) {
+    // Expected value of the smooth Coulomb law erf(dq/(√2 v_c)) given the noisy velocity dq̂
+    // (Gaussian noise σ_dq, flat prior): erf(dq̂/(√2·√(v_c² + σ²))); with v_c = 0 the expected
+    // sign of seed 1's Fc·sign(dq) term. Its halves are the moving-positive/-negative indicators.
+    Eigen::VectorXd width = given_coulomb_width(options.coulomb_width, n);
+    const bool automatic = width.size() == 0;
+    if (automatic) {
+      const double f = options.coulomb_width_fraction;
+      if (!(f >= 0.0 && f < 1.0)) {
+        throw UsageError("coulomb_width_fraction " + fmt(f) + " is not in [0, 1); use e.g. 0.005");
       }
+      width = f * r.dq.middleRows(first, last - first).cwiseAbs().colwise().maxCoeff().transpose();
     }
-    out.moving_positive = take_rows(filtfilt(filter, pos), first, last, decimate);
-    out.moving_negative = take_rows(filtfilt(filter, neg), first, last, decimate);
-    choices.emplace_back("coulomb_columns",
-                         "expected sign erf(dq/(sqrt(2) sigma_dq)) of the velocity, filtered like "
-                         "tau at the full rate (parallel filtering)");
+    // The smooth law's expected value erf(v/(√2·√(v_c² + σ²))) and its halves, filtered like tau.
+    const auto indicators = [&](const Eigen::MatrixXd& v, const Eigen::VectorXd& scale) {
+      Eigen::MatrixXd pos(v.rows(), v.cols()), neg(v.rows(), v.cols());
+      for (Eigen::Index j = 0; j < v.cols(); ++j) {
+        for (Eigen::Index k = 0; k < v.rows(); ++k) {
+          const double x = v(k, j);
+          const double s = std::erf(x / (std::sqrt(2.0) * scale[j]));
+          pos(k, j) = scale[j] > 0.0 ? 0.5 * (1.0 + s) : static_cast<double>(x > 0.0);
+          neg(k, j) = scale[j] > 0.0 ? 0.5 * (1.0 - s) : static_cast<double>(x < 0.0);
+        }
+      }
+      return std::make_pair(take_rows(filtfilt(filter, pos), first, last, decimate),
+                            take_rows(filtfilt(filter, neg), first, last, decimate));
+    };
+    const Eigen::VectorXd scale =
+        (out.velocity_noise_std.array().square() + width.array().square()).sqrt();
+    std::tie(out.moving_positive, out.moving_negative) = indicators(r.dq, scale);
+    // With v_c = 0 the motors keep the hard sign of coupling_regressor (the former law).
+    if (width.maxCoeff() > 0.0 && coupled_rows.rows() > 0 && coupled_rows.cols() == n) {
+      const Eigen::VectorXd motor_scale =
+          (coupled_rows.array().square().matrix() * scale.array().square().matrix()).cwiseSqrt();
+      const auto motor = indicators(r.dq * coupled_rows.transpose(), motor_scale);
+      out.coupled_sign = motor.first - motor.second;
+    }
+    out.coulomb_width = width;
+    if (width.maxCoeff() > 0.0) {
+      std::ostringstream w;
+      w << std::setprecision(3) << width.transpose();
+      choices.emplace_back("coulomb_columns",
+                           "expected smooth sign erf(dq/(sqrt(2) sqrt(v_c^2 + sigma_dq^2))) of the "
+                           "velocity, v_c = [" +
+                               w.str() + "] (" +
+                               (automatic ? fmt(options.coulomb_width_fraction) + " x max|dq_j|"
+                                          : options.coulomb_width_source) +
+                               "), filtered like tau at the full rate (parallel filtering)");
+    } else {
+      choices.emplace_back(
+          "coulomb_columns",
+          "expected sign erf(dq/(sqrt(2) sigma_dq)) of the velocity, filtered like "
+          "tau at the full rate (parallel filtering)");
+    }
   }
   return out;
+}
+
+Eigen::MatrixXd coupled_motor_rows(const Model& model) {
+  const std::vector<int> motors = coupled_motors(model);
+  Eigen::MatrixXd rows(static_cast<Eigen::Index>(motors.size()), model.dof());
+  for (size_t c = 0; c < motors.size(); ++c) {
+    const Eigen::RowVectorXd n_k = model.transmission.N.row(motors[c]);
+    rows.row(static_cast<Eigen::Index>(c)) = n_k / n_k.cwiseAbs().maxCoeff();
+  }
+  return rows;
 }
 
 Eigen::MatrixXd processed_regressor(const Model& model, const ParameterLayout& layout,
                                     bool coupling, const ProcessedRecord& processed) {
   Eigen::MatrixXd W = stacked_regressor(model, layout, coupling, processed.record);
-  if (processed.moving_positive.size() == 0 || !layout.coulomb) return W;
   const int n = model.dof();
+  if (coupling && processed.coupled_sign.size() != 0) {
+    // The motors' Fcm columns n_kj·sign(n_k·dq) (coupling_regressor) with the same smooth law.
+    const Eigen::MatrixXd rows = coupled_motor_rows(model);
+    const Eigen::Index p = layout.columns(n);
+    for (Eigen::Index k = 0; k < processed.record.t.size(); ++k) {
+      for (Eigen::Index c = 0; c < rows.rows(); ++c) {
+        for (int j = 0; j < n; ++j) {
+          if (rows(c, j) != 0.0)
+            W(k * n + j, p + 3 * c + 2) = rows(c, j) * processed.coupled_sign(k, c);
+        }
+      }
+    }
+  }
+  if (processed.moving_positive.size() == 0 || !layout.coulomb) return W;
   // Column of the first Coulomb term of joint j: after its armature and viscous terms
   // (joint_columns order, regressor/joint_columns.hpp).
   const int repeat = layout.asymmetric ? 2 : 1;
@@ -317,14 +379,32 @@ Eigen::MatrixXd processed_regressor(const Model& model, const ParameterLayout& l
   return W;
 }
 
-Eigen::VectorXd given_zero_velocity(const std::vector<double>& zero_velocity, int n) {
-  if (zero_velocity.empty()) return Eigen::VectorXd();
-  if (zero_velocity.size() == 1) return Eigen::VectorXd::Constant(n, zero_velocity[0]);
-  if (static_cast<int>(zero_velocity.size()) == n) {
-    return Eigen::Map<const Eigen::VectorXd>(zero_velocity.data(), n);
+namespace {
+
+// One value for all n joints or n values of the option `flag`; empty stays empty.
+Eigen::VectorXd per_joint_values(const std::vector<double>& values, int n, const char* flag) {
+  if (values.empty()) return Eigen::VectorXd();
+  if (values.size() == 1) return Eigen::VectorXd::Constant(n, values[0]);
+  if (static_cast<int>(values.size()) == n) {
+    return Eigen::Map<const Eigen::VectorXd>(values.data(), n);
   }
-  throw UsageError("--zero-velocity takes 1 or " + std::to_string(n) + " values, got " +
-                   std::to_string(zero_velocity.size()));
+  throw UsageError(std::string(flag) + " takes 1 or " + std::to_string(n) + " values, got " +
+                   std::to_string(values.size()));
+}
+
+}  // namespace
+
+Eigen::VectorXd given_zero_velocity(const std::vector<double>& zero_velocity, int n) {
+  return per_joint_values(zero_velocity, n, "--zero-velocity");
+}
+
+Eigen::VectorXd given_coulomb_width(const std::vector<double>& width, int n) {
+  for (const double v : width) {
+    if (!(v >= 0.0) || !std::isfinite(v)) {
+      throw UsageError("--coulomb-width values must be finite and >= 0 [rad/s], not " + fmt(v));
+    }
+  }
+  return per_joint_values(width, n, "--coulomb-width");
 }
 
 // preprocess() of a run of `model`, after checking that it has one column per joint.
@@ -336,7 +416,7 @@ ProcessedRecord preprocess_run(const Model& model, const JointRecord& record,
                 model.name + "' has " + std::to_string(model.dof()) +
                 "; pass the run of this robot or the model it was recorded on");
   }
-  return preprocess(record, options, choices);
+  return preprocess(record, options, choices, coupled_motor_rows(model));
 }
 
 // Rows of joint j where |dq_j| is below threshold_j, too small for sign(dq_j) to be meaningful, are
@@ -365,11 +445,19 @@ Eigen::VectorXd zero_velocity_threshold(const ParameterLayout& layout, const Sig
     const Eigen::VectorXd band =
         f * processed.record.dq.cwiseAbs().colwise().maxCoeff().transpose();
     threshold = band.cwiseMax(k * processed.velocity_noise_std);
-    s << "auto: rows with |dq_j| < [" << threshold.transpose() << "] " << verb << " = max(" << f
-      << " x max|dq_j| (real friction leaves the Coulomb law there), " << k
-      << " x the velocity noise std [" << processed.velocity_noise_std.transpose()
-      << "] (the sign of dq is unknown there)); Coulomb columns: the filtered expected sign, "
-         "which keeps Fv and Fc unbiased when the cut-off smears the Coulomb step";
+    if (threshold.maxCoeff() > 0.0) {
+      s << "auto: rows with |dq_j| < [" << threshold.transpose() << "] " << verb << " = max(" << f
+        << " x max|dq_j| (real friction leaves the Coulomb law there), " << k
+        << " x the velocity noise std [" << processed.velocity_noise_std.transpose()
+        << "] (the sign of dq is unknown there)); Coulomb columns: the filtered expected sign, "
+           "which keeps Fv and Fc unbiased when the cut-off smears the Coulomb step";
+    } else {
+      // Removing rows by the size of a filtered, noisy velocity selects on the regressor; the
+      // smooth expected-sign columns model the unknown sign and the pre-sliding band instead
+      // (docs/methods/identification.md §3).
+      s << "none: every row is kept; the Coulomb columns are the filtered expected smooth sign, "
+           "which models the unknown sign of dq at rest and the pre-sliding band";
+    }
   } else {
     s << "rows with |dq_j| < [" << threshold.transpose() << "] " << verb << " ("
       << signal.zero_velocity_source << ")";
@@ -389,6 +477,7 @@ void hold_still_joints(const Model& model, ProcessedRecord& p,
                        std::vector<std::pair<std::string, std::string>>& choices) {
   JointRecord& r = p.record;
   std::string still;
+  std::vector<bool> held(static_cast<size_t>(r.dq.cols()), false);
   for (Eigen::Index j = 0; j < r.dq.cols(); ++j) {
     const double sigma = j < p.velocity_noise_std.size() ? p.velocity_noise_std[j] : 0.0;
     const double peak = r.dq.col(j).cwiseAbs().maxCoeff();
@@ -405,6 +494,7 @@ void hold_still_joints(const Model& model, ProcessedRecord& p,
       p.moving_positive.col(j).setZero();
       p.moving_negative.col(j).setZero();
     }
+    held[j] = true;
     std::ostringstream w;
     w << std::setprecision(3) << model.joints[static_cast<size_t>(j)].name;
     if (constant) {
@@ -413,6 +503,16 @@ void hold_still_joints(const Model& model, ProcessedRecord& p,
       w << " (max|dq| " << peak << " < " << kStillNoiseMultiple << " x noise std " << sigma << ")";
     }
     still += (still.empty() ? "" : ", ") + w.str();
+  }
+  // A coupled motor all of whose joints are held does not turn: its Coulomb column is noise too.
+  if (p.coupled_sign.size()) {
+    const Eigen::MatrixXd rows = coupled_motor_rows(model);
+    for (Eigen::Index c = 0; c < rows.rows() && c < p.coupled_sign.cols(); ++c) {
+      bool turns = false;
+      for (Eigen::Index j = 0; j < rows.cols(); ++j)
+        turns = turns || (rows(c, j) != 0.0 && !held[j]);
+      if (!turns) p.coupled_sign.col(c).setZero();
+    }
   }
   if (!still.empty()) {
     choices.emplace_back("still_joints",

@@ -12,6 +12,13 @@
 
 namespace dynid {
 
+namespace {
+
+// A row whose |dq̂| is within 3 velocity-noise stds of zero cannot be told from standing still.
+constexpr double kStillNoiseBand = 3.0;
+
+}  // namespace
+
 ValidationResult validate_torques(const Model& model, const JointRecord& record,
                                   const std::vector<std::string>& names,
                                   const Eigen::VectorXd& values, const IdentifyOptions& options,
@@ -133,6 +140,32 @@ ValidationResult validate_torques(const Model& model, const JointRecord& record,
         "every sample is below the zero-velocity threshold; the run does not move, or "
         "lower --zero-velocity");
   }
+  // Still rows (issue 25 item 9): inside the smooth Coulomb law's band or the velocity noise.
+  out.still_threshold = Eigen::VectorXd::Zero(n);
+  for (int j = 0; j < n; ++j) {
+    const double width =
+        j < out.processed.coulomb_width.size() ? out.processed.coulomb_width[j] : 0.0;
+    const double sigma =
+        j < out.processed.velocity_noise_std.size() ? out.processed.velocity_noise_std[j] : 0.0;
+    out.still_threshold[j] = std::max(width, kStillNoiseBand * sigma);
+  }
+  out.joint_rows_still = Eigen::VectorXi::Zero(n);
+  double still_e2 = 0.0, still_y2 = 0.0, moving_e2 = 0.0, moving_y2 = 0.0;
+  for (Eigen::Index k = 0; k < m; ++k) {
+    for (int j = 0; j < n; ++j) {
+      const double ee = e(k, j) * e(k, j), yy = r.tau(k, j) * r.tau(k, j);
+      if (std::abs(r.dq(k, j)) < out.still_threshold[j]) {
+        ++out.joint_rows_still[j];
+        still_e2 += ee;
+        still_y2 += yy;
+      } else {
+        moving_e2 += ee;
+        moving_y2 += yy;
+      }
+    }
+  }
+  out.relative_error_still_rows = still_y2 > 0.0 ? std::sqrt(still_e2 / still_y2) : 0.0;
+  out.relative_error_moving_rows = moving_y2 > 0.0 ? std::sqrt(moving_e2 / moving_y2) : 0.0;
   out.rms = (e2.array() / cnt.array().max(1.0)).sqrt();
   out.relative_error = (e2.array() / y2.array().max(1e-300)).sqrt();
   out.relative_error_all = std::sqrt(e2.sum() / std::max(y2.sum(), 1e-300));

@@ -56,6 +56,22 @@ std::string line(const char* format, ...) {
   return buf;
 }
 
+// The array `key` of a result file as non-negative finite numbers; empty when absent.
+std::vector<double> non_negative_numbers(const nlohmann::json& j, const char* key,
+                                         const std::string& path) {
+  std::vector<double> out;
+  const auto it = j.find(key);
+  if (it == j.end() || !it->is_array()) return out;
+  for (const auto& x : *it) {
+    if (!x.is_number() || !std::isfinite(x.get<double>()) || x.get<double>() < 0.0) {
+      throw Error("'" + path + "': " + key +
+                  " must be non-negative numbers; write the file with dynid identify");
+    }
+    out.push_back(x.get<double>());
+  }
+  return out;
+}
+
 }  // namespace
 
 nlohmann::json identification_to_json(const Model& model, const IdentificationResult& r,
@@ -129,6 +145,7 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
                         {"residual_autocorrelation", numbers(r.residual_autocorrelation)},
                         {"relative_error", json_number(r.relative_error)},
                         {"zero_velocity_threshold", numbers(r.zero_velocity_threshold)},
+                        {"coulomb_width", numbers(r.coulomb_width)},
                         {"residual_variance", json_number(e.residual_variance)},
                         {"estimator", to_string(e.summary.estimator)},
                         {"unidentifiable", r.unidentifiable},
@@ -281,17 +298,8 @@ IdentifiedResultFile identification_result_from_json(const nlohmann::json& j,
     }
   }
   out.locked_joints = locked_joints_from_json(j, path);
-  const auto threshold = j.find("zero_velocity_threshold");
-  if (threshold != j.end() && threshold->is_array()) {
-    for (const auto& x : *threshold) {
-      if (!x.is_number() || !std::isfinite(x.get<double>()) || x.get<double>() < 0.0) {
-        throw Error("'" + path +
-                    "': zero_velocity_threshold must be non-negative numbers; write the file "
-                    "with dynid identify");
-      }
-      out.zero_velocity_threshold.push_back(x.get<double>());
-    }
-  }
+  out.zero_velocity_threshold = non_negative_numbers(j, "zero_velocity_threshold", path);
+  out.coulomb_width = non_negative_numbers(j, "coulomb_width", path);
   const auto not_excited = j.find("not_excited");
   if (not_excited != j.end()) {
     if (!not_excited->is_array()) {
@@ -407,6 +415,17 @@ nlohmann::json validation_to_json(const Model& model, const ValidationResult& v)
              "keep every row"},
             {"zero_velocity_threshold", numbers(v.zero_velocity_threshold)},
             {"rows", v.rows_excluded}}},
+          {"rows_still",
+           {{"rule",
+             "rows of joint j with |dq_j| < threshold[j] = max(coulomb_width[j], 3 x the "
+             "velocity noise std) count as still: the joint is inside the Coulomb law's "
+             "transition band (its term below 68 % of Fc) or cannot be told from rest; they are "
+             "predicted with the same smooth Coulomb law identify fitted and kept in every "
+             "figure above"},
+            {"threshold", numbers(v.still_threshold)},
+            {"rows", numbers(v.joint_rows_still.cast<double>())},
+            {"relative_error_still_rows", json_number(v.relative_error_still_rows)},
+            {"relative_error_moving_rows", json_number(v.relative_error_moving_rows)}}},
           {"completed", v.completed},
           {"filled_share", json_number(v.filled_share)},
           {"warnings", v.warnings},

@@ -90,6 +90,13 @@ StoredIdentifyOptions options_of_stored_result(const IdentifiedResultFile& ident
         out.notes.push_back("--time-shift as given to identify (stored in '" + path + "')");
     }
     o.signal.filter_coulomb_columns = file.get("filter_coulomb_columns", false);
+    // The Coulomb law identify used, so that rest is predicted as it was fitted (issue 25 item 9).
+    if (static_cast<int>(identified.coulomb_width.size()) == dof) {
+      o.signal.coulomb_width = identified.coulomb_width;
+      o.signal.coulomb_width_source = "as identify used them";
+    } else {
+      o.signal.coulomb_width_fraction = 0.0;  // a file written before the law was stored
+    }
     // The rows left out are those below the thresholds identify used (stored in the result), not
     // thresholds recomputed from this run.
     if (!overrides.zero_velocity.empty()) {

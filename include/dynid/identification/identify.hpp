@@ -94,6 +94,10 @@ struct IdentificationResult {
   /// Per joint, the |dq_j| below which rows were left out of the fit [rad/s or m/s]; zeros when
   /// none were (validate_torques reuses these, so a validation compares the same kind of rows).
   Eigen::VectorXd zero_velocity_threshold;
+  /// Per joint, the transition velocity v_c of the smooth Coulomb law the fit used [rad/s or m/s]
+  /// (ProcessedRecord::coulomb_width, the largest over runs); empty without expected-sign columns.
+  /// validate_torques predicts rest with the same law.
+  Eigen::VectorXd coulomb_width;
   BaseParameters base;           ///< the base set on which the estimate lives
   ProcessedRecord processed;     ///< the data as used (the first run's)
   std::vector<RunSummary> runs;  ///< per run, in the order given

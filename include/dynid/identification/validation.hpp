@@ -40,6 +40,14 @@ struct ValidationResult {
   Eigen::Index samples = 0;                 ///< samples after preprocessing
   Eigen::Index rows = 0;           ///< joint equations compared (samples × joints − excluded)
   Eigen::Index rows_excluded = 0;  ///< near-zero-velocity rows left out, as identify() does
+  /// Per joint, the |dq_j| below which a row counts as still [rad/s or m/s]: max(v_c,j, 3·σ_dq,j),
+  /// inside the Coulomb law's transition band (its term below erf(1/√2) = 68 % of Fc) or the
+  /// velocity noise. Still rows are predicted (with the smooth law) and kept in every figure
+  /// above; the split below only reports how well rest is predicted.
+  Eigen::VectorXd still_threshold;
+  Eigen::VectorXi joint_rows_still;         ///< per joint, rows below still_threshold
+  double relative_error_still_rows = 0.0;   ///< ‖e‖/‖tau‖ over the still rows (0 if none)
+  double relative_error_moving_rows = 0.0;  ///< ‖e‖/‖tau‖ over the other rows (0 if none)
   std::vector<std::pair<std::string, std::string>> choices;  ///< processing choices made
   ProcessedRecord processed;
   Eigen::MatrixXd predicted;  ///< samples × n predicted torques

@@ -37,6 +37,9 @@ struct IdentifiedResultFile {
   /// `zero_velocity_threshold` per joint as identify used it; empty in files written before it
   /// was stored.
   std::vector<double> zero_velocity_threshold;
+  /// `coulomb_width` per joint, the smooth Coulomb law's transition velocity identify used
+  /// [rad/s or m/s]; empty in files written before it was stored (the sign law then).
+  std::vector<double> coulomb_width;
   /// `choices.cutoff_hz`, the low-pass cut-off identify used [Hz]; 0 when absent (no filter, or
   /// a file written before it was stored).
   double cutoff_hz = 0.0;
