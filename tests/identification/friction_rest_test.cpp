@@ -20,14 +20,14 @@
 namespace dynid {
 namespace {
 
-constexpr double kRate = 100.0;  // a cobot-like log rate
-constexpr double kNoise = 1e-5;  // encoder noise [rad], fed back
+constexpr double kRestRate = 100.0;  // a cobot-like log rate
+constexpr double kRestNoise = 1e-5;  // encoder noise [rad], fed back
 
 // A run on the plant with a Stribeck bump of `stiction_ratio` × Fc (1 = none).
 JointRecord plant_run(const Model& m, double stiction_ratio, unsigned seed) {
   const TrajectorySamples tr =
-      sample_trajectory(FourierTrajectory(testing::planar2_reference()), kRate, false);
-  SimulateOptions so = testing::noisy_sensors(kNoise, 0.05, seed, 6);
+      sample_trajectory(FourierTrajectory(testing::planar2_reference()), kRestRate, false);
+  SimulateOptions so = testing::noisy_sensors(kRestNoise, 0.05, seed, 6);
   if (stiction_ratio != 1.0) {
     so.plant.native.friction.stiction =
         stiction_ratio * Eigen::Vector2d(m.joints[0].friction.Fc, m.joints[1].friction.Fc);
@@ -35,15 +35,15 @@ JointRecord plant_run(const Model& m, double stiction_ratio, unsigned seed) {
   return testing::closed_loop_run(m, tr, so);
 }
 
-IdentifyOptions held_torque() {
+IdentifyOptions rest_held_torque() {
   IdentifyOptions o;
-  o.signal.torque_time_offset = 0.5 / kRate;  // the logged command is held over the next step
+  o.signal.torque_time_offset = 0.5 / kRestRate;  // the logged command is held over the next step
   return o;
 }
 
 // Every row kept, the Coulomb columns the smooth law with v_c = 0.5 % of max|q̇_j|.
 IdentifyOptions keep_rows() {
-  IdentifyOptions o = held_torque();
+  IdentifyOptions o = rest_held_torque();
   o.signal.zero_velocity_fraction = 0.0;
   o.signal.zero_velocity_noise_multiple = 0.0;
   o.signal.coulomb_width_fraction = 0.005;
@@ -52,7 +52,7 @@ IdentifyOptions keep_rows() {
 
 // The default: rows below max(1 % of max|q̇_j|, 3 σ_q̇) removed, v_c = 0.
 IdentifyOptions former_rule() {
-  return held_torque();
+  return rest_held_torque();
 }
 
 double value(const IdentificationResult& r, const std::string& name) {

@@ -135,8 +135,8 @@ TEST_F(Tx40Dataset, SmoothCoulombLawKeepsEveryRowAndReachesThePublishedFriction)
   o.signal.coulomb_width_fraction = 0.005;
   const IdentificationResult r = identify(model, record_, o);
   EXPECT_EQ(r.rows, 6 * r.samples);
-  const YAML::Node p =
-      YAML::LoadFile(kData + "/config/T40X_config.yaml")["identification"]["robot_params"][0];
+  const YAML::Node p = YAML::LoadFile(
+      kTx40DataDir + "/config/T40X_config.yaml")["identification"]["robot_params"][0];
   const auto at = [&r](const std::string& name) {
     const auto it = std::find(r.names.begin(), r.names.end(), name);
     EXPECT_NE(it, r.names.end()) << name;
