@@ -21,7 +21,9 @@ std::filesystem::path scratch() {
 }
 
 CsvTable excite(const std::string& args) {
-  const std::string out = (scratch() / "ref.csv").string();
+  // One file per test: ctest runs the tests of this file in parallel processes.
+  const std::string test_name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  const std::string out = (scratch() / (test_name + ".csv")).string();
   std::filesystem::remove(out);
   const testing::CliResult r = testing::run_dynid("excite " + args + " --out " + out, scratch());
   EXPECT_EQ(r.code, 0) << r.err;
