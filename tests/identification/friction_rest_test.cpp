@@ -5,13 +5,17 @@
 // expected-sign law (v_c = 0.5 % of max|q̇_j|) against the default rule (rows with |q̇_j| < 1 % of
 // max|q̇_j| removed). docs/methods/identification.md §3 has the table.
 #include <cmath>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include "dynid/common/error.hpp"
 #include "dynid/excitation/fourier_trajectory.hpp"
 #include "dynid/excitation/trajectory_samples.hpp"
 #include "dynid/identification/identify.hpp"
+#include "dynid/identification/record.hpp"
 #include "dynid/identification/validation.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/sim/simulate_reference.hpp"
@@ -137,6 +141,33 @@ TEST(FrictionRest, ValidationUsesTheFittedLawAndReportsStillRows) {
   EXPECT_EQ(v.joint_rows_still[0], still);
   EXPECT_GT(still, 0);  // the reference reverses: some rows are inside the band
   EXPECT_GE(v.still_threshold[0], r.coulomb_width[0]);
+}
+
+}  // namespace
+}  // namespace dynid
+
+namespace dynid {
+namespace {
+
+// --coulomb-width: one value for every joint or one per joint, finite and non-negative; anything
+// else is one line naming the flag.
+TEST(FrictionRest, CoulombWidthValuesAreCheckedWithOneLineNamingTheFlag) {
+  EXPECT_EQ(given_coulomb_width({0.01}, 3), Eigen::Vector3d::Constant(0.01));
+  EXPECT_EQ(given_coulomb_width({0.01, 0.0}, 2), Eigen::Vector2d(0.01, 0.0));
+  EXPECT_EQ(given_coulomb_width({}, 3).size(), 0);
+  for (const std::vector<double>& bad :
+       {std::vector<double>{-0.1}, std::vector<double>{std::nan("")},
+        std::vector<double>{std::numeric_limits<double>::infinity()},
+        std::vector<double>{0.1, 0.2, 0.3}}) {
+    try {
+      given_coulomb_width(bad, 2);
+      ADD_FAILURE() << "no error for " << bad.size() << " values";
+    } catch (const UsageError& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("--coulomb-width"), std::string::npos) << m;
+      EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    }
+  }
 }
 
 }  // namespace
