@@ -25,6 +25,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -88,6 +89,13 @@ double rms(const Eigen::VectorXd& v) {
 
 int run(const std::string& out_path) {
   using namespace dynid;
+  // A folder that does not exist is known before the 8 s of simulation, not after them.
+  const std::filesystem::path folder = std::filesystem::path(out_path).parent_path();
+  if (!folder.empty() && !std::filesystem::is_directory(folder)) {
+    std::cerr << "error: cannot write " << out_path << ": folder " << folder.string()
+              << " does not exist; create it or give a writable OUT.csv\n";
+    return 1;
+  }
   const Model nominal = load_robot("iiwa14");
   const Model loaded = with_payload(nominal);
   const int n = nominal.dof();
