@@ -10,7 +10,7 @@ namespace {
 using test::error_of;
 using test::TempDir;
 
-const std::string kFixtures = DYNID_SOURCE_DIR "/tests/data/csv/";
+const std::string kFixtures = std::string(DYNID_SOURCE_DIR) + "/tests/data/csv/";
 
 TEST(CsvReader, ReadsHeaderCommentsCrlfBlankLinesSpacesQuotesAndSigns) {
   const CsvTable t = read_csv(kFixtures + "valid_crlf.csv");

@@ -13,7 +13,7 @@ using test::error_of;
 const std::vector<std::string> kJoints{"shoulder", "elbow"};
 
 TEST(JointColumns, NumberedNamedAnyOrderExtraColumnsIgnored) {
-  const CsvTable t = read_csv(DYNID_SOURCE_DIR "/tests/data/csv/named_columns.csv");
+  const CsvTable t = read_csv(std::string(DYNID_SOURCE_DIR) + "/tests/data/csv/named_columns.csv");
   // Header: t,q_elbow,ddq2,dq_shoulder,q1,ddq_shoulder,dq2
   EXPECT_EQ(resolve_joint_columns(t.columns, kJoints, "q", t.source),
             (std::vector<Eigen::Index>{4, 1}));
