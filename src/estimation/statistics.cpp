@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -66,17 +69,13 @@ void fill_parameter_statistics(Estimate& e, const EstimationOptions& options) {
   }
 }
 
-double fixed_b_critical_value(double level, double b) {
-  if (!(level > 0.0 && level < 1.0)) {
-    throw Error("confidence level " + std::to_string(level) +
-                " is outside (0, 1); pass a level such as 0.95 or 0.999");
-  }
-  if (!(b >= 0.0 && b <= 1.0)) {
-    throw Error("fixed-b fraction " + std::to_string(b) +
-                " is outside [0, 1]; pass (bandwidth + 1)/samples");
-  }
-  constexpr int kSteps = 1000, kDraws = 2000;
-  const int M = std::max(1, static_cast<int>(std::lround(b * kSteps)));
+namespace {
+
+constexpr int kFixedBSteps = 1000, kFixedBDraws = 2000;
+
+// The simulation behind fixed_b_critical_value for a window of M of its kFixedBSteps steps.
+double simulate_fixed_b_critical_value(double level, int M) {
+  constexpr int kSteps = kFixedBSteps, kDraws = kFixedBDraws;
   // Own Box–Muller on mt19937_64 (whose output the standard fixes): the same values everywhere.
   std::mt19937_64 rng(20050601);
   const double two_pi = 2.0 * std::acos(-1.0), scale = 1.0 / 18446744073709551616.0;
@@ -110,6 +109,56 @@ double fixed_b_critical_value(double level, double b) {
     (coverage(mid) < level ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
+}
+
+}  // namespace
+
+double fixed_b_critical_value(double level, double b) {
+  if (!(level > 0.0 && level < 1.0)) {
+    throw Error("confidence level " + std::to_string(level) +
+                " is outside (0, 1); pass a level such as 0.95 or 0.999");
+  }
+  if (!(b >= 0.0 && b <= 1.0)) {
+    throw Error("fixed-b fraction " + std::to_string(b) +
+                " is outside [0, 1]; pass (bandwidth + 1)/samples");
+  }
+  const int M = std::max(1, static_cast<int>(std::lround(b * kFixedBSteps)));
+  // The value depends on (level, M) only and its simulation has a fixed seed, so it is computed
+  // once per process: one simulation costs 2·10⁶ normal draws (50-150 ms), which every HAC
+  // estimate, every run of a Monte-Carlo test and every stage of a project file paid again.
+  static std::mutex mutex;
+  static std::map<std::pair<double, int>, double> known;
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    const auto it = known.find({level, M});
+    if (it != known.end()) return it->second;
+  }
+  const double c = simulate_fixed_b_critical_value(level, M);
+  const std::lock_guard<std::mutex> lock(mutex);
+  known.emplace(std::make_pair(level, M), c);
+  return c;
+}
+
+Eigen::MatrixXd bartlett_long_run_covariance(const Eigen::Ref<const Eigen::MatrixXd>& G, int lags) {
+  if (lags < 0) {
+    throw Error("bartlett_long_run_covariance: " + std::to_string(lags) + " lags; pass 0 or more");
+  }
+  const Eigen::Index T = G.rows(), p = G.cols();
+  Eigen::MatrixXd S = Eigen::MatrixXd::Zero(p, p);
+  if (T == 0) return S;
+  const Eigen::Index M = std::min<Eigen::Index>(lags, T - 1) + 1;
+  // C_t = Σ_{u<t} g_u; window j covers samples [j, j + M − 1] ∩ [0, T − 1], j = −M+1 … T−1, and
+  // its sum is B_j = C_min(j+M,T) − C_max(j,0).
+  Eigen::MatrixXd C(T + 1, p);
+  C.row(0).setZero();
+  for (Eigen::Index t = 0; t < T; ++t) C.row(t + 1) = C.row(t) + G.row(t);
+  Eigen::MatrixXd B(T + M - 1, p);
+  for (Eigen::Index j = -M + 1; j < T; ++j) {
+    B.row(j + M - 1) = C.row(std::min(j + M, T)) - C.row(std::max<Eigen::Index>(j, 0));
+  }
+  S.selfadjointView<Eigen::Lower>().rankUpdate(B.transpose(), 1.0 / static_cast<double>(M));
+  S.triangularView<Eigen::StrictlyUpper>() = S.transpose();
+  return S;
 }
 
 namespace {
@@ -189,12 +238,7 @@ HacSummary apply_hac_covariance(Estimate& e, const Eigen::Ref<const Eigen::Matri
   }
   out.score_lag1 = lag1;
   out.bandwidth = L;
-  Eigen::MatrixXd S = G.transpose() * G;
-  for (int l = 1; l <= L; ++l) {
-    const double w = 1.0 - static_cast<double>(l) / (L + 1.0);
-    const Eigen::MatrixXd gamma = G.bottomRows(Tv - l).transpose() * G.topRows(Tv - l);
-    S += w * (gamma + gamma.transpose());
-  }
+  Eigen::MatrixXd S = bartlett_long_run_covariance(G, L);
   if (options.prewhiten && T > 2) {
     const Eigen::MatrixXd R =
         (Eigen::MatrixXd::Identity(p, p) - A).fullPivLu().solve(Eigen::MatrixXd::Identity(p, p));

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <Eigen/Dense>
 
+#include "dynid/common/error.hpp"
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/statistics.hpp"
 #include "support/estimation_support.hpp"
@@ -284,6 +285,60 @@ TEST(HacCoverage, WeightedLeastSquaresSandwichReachesItsLevelUnderAr1Residuals) 
   const Coverage c = coverage(Residual::kAr1, true, kReps, 14);
   EXPECT_GE(c.hac, kReached);
   EXPECT_LT(c.white, 0.8);
+}
+
+// The Bartlett sum as it is defined, lag by lag (what apply_hac_covariance computed before the
+// window sums): S = Γ_0 + Σ_{l=1..L} (1 − l/(L+1))·(Γ_l + Γ_lᵀ).
+Eigen::MatrixXd lag_by_lag_bartlett(const Eigen::MatrixXd& G, int L) {
+  const Eigen::Index T = G.rows();
+  L = std::min<int>(L, static_cast<int>(T) - 1);
+  Eigen::MatrixXd S = G.transpose() * G;
+  for (int l = 1; l <= L; ++l) {
+    const double w = 1.0 - static_cast<double>(l) / (L + 1.0);
+    const Eigen::MatrixXd gamma = G.bottomRows(T - l).transpose() * G.topRows(T - l);
+    S += w * (gamma + gamma.transpose());
+  }
+  return S;
+}
+
+TEST(BartlettLongRunCovariance, EqualsTheLagByLagSumForEveryWindow) {
+  // Correlated AR(1) scores with a mean, so that the running sums grow as they do on real scores.
+  const Eigen::Index T = 600, p = 4;
+  std::mt19937 rng(31);
+  std::normal_distribution<double> n01;
+  Eigen::MatrixXd G(T, p);
+  Eigen::RowVectorXd g = Eigen::RowVectorXd::Zero(p);
+  for (Eigen::Index t = 0; t < T; ++t) {
+    for (Eigen::Index a = 0; a < p; ++a) g(a) = 0.9 * g(a) + n01(rng) + 0.1 * a;
+    G.row(t) = g;
+  }
+  for (const int L : {0, 1, 7, 149, 599, 5000}) {
+    const Eigen::MatrixXd expected = lag_by_lag_bartlett(G, L);
+    const Eigen::MatrixXd S = bartlett_long_run_covariance(G, L);
+    EXPECT_LT((S - expected).norm(), 1e-12 * expected.norm()) << "L = " << L;
+    EXPECT_EQ((S - S.transpose()).norm(), 0.0) << "L = " << L;
+  }
+  EXPECT_THROW(bartlett_long_run_covariance(G, -1), Error);
+  EXPECT_EQ(bartlett_long_run_covariance(Eigen::MatrixXd(0, 3), 4).norm(), 0.0);
+}
+
+TEST(BartlettLongRunCovariance, ConstantScoresGiveTheClosedForm) {
+  // g_t = 1: S = T + 2·Σ_{l=1..L} (1 − l/(L+1))·(T − l) = T + L·T − L·(L+1) + L·(2L+1)/3.
+  for (const int T : {1, 2, 10, 1000}) {
+    for (const int L : {0, 1, 3, 9}) {
+      if (L > T - 1) continue;
+      const double expected = T + double(L) * T - double(L) * (L + 1) + L * (2.0 * L + 1) / 3.0;
+      const Eigen::MatrixXd S = bartlett_long_run_covariance(Eigen::MatrixXd::Ones(T, 1), L);
+      EXPECT_NEAR(S(0, 0), expected, 1e-12 * expected) << "T = " << T << ", L = " << L;
+    }
+  }
+}
+
+TEST(FixedBCriticalValue, ASecondCallReturnsTheSameValue) {
+  // Computed once per (level, window) and kept: the second call must not differ in any bit.
+  const double first = fixed_b_critical_value(0.9, 0.031);
+  EXPECT_EQ(fixed_b_critical_value(0.9, 0.031), first);
+  EXPECT_NE(fixed_b_critical_value(0.99, 0.031), first);
 }
 
 }  // namespace

@@ -56,6 +56,15 @@ struct HacSummary {
 /// Throws dynid::Error if level ∉ (0, 1) or b ∉ [0, 1].
 double fixed_b_critical_value(double level, double b);
 
+/// Bartlett (Newey–West) long-run covariance of a score series: S = Σ_|l|≤L (1 − |l|/(L+1))·Γ_l,
+/// Γ_l = Σ_k g_k g_{k−l}ᵀ, for `scores` (T×p, row k = g_kᵀ) and `lags` = L ≥ 0 (capped at T − 1).
+/// Identity used: with M = L + 1, (M − |t−s|)₊ counts the windows of M consecutive samples that
+/// hold both t and s, so S = (1/M)·Σ_j B_j B_jᵀ with B_j the sum of the scores in window j, formed
+/// from running sums in O(T·p²) whatever L (the lag-by-lag sum costs O(L·T·p²)). Newey & West
+/// (1987); derivation in docs/methods/estimation.md §5. Throws dynid::Error if lags < 0.
+Eigen::MatrixXd bartlett_long_run_covariance(const Eigen::Ref<const Eigen::MatrixXd>& scores,
+                                             int lags);
+
 /// Replaces the white-noise covariance of `estimate` by the Newey–West (HAC) sandwich
 /// C = m/(m−r) · B·S·B with bread B = (WᵀW)⁻¹ = covariance/σ² (the estimator's own, so the
 /// weighting of WLS and the prior of RLS carry over), and meat S = Σ_|l|≤L (1 − |l|/(L+1))·Γ_l,
