@@ -42,8 +42,9 @@ std::string unknown_command(const CLI::App& app, int argc, char** argv) {
 
 int main(int argc, char** argv) {
   CLI::App app{"dynid: identification of robot dynamic parameters (see docs/cli.md)", "dynid"};
-  app.set_version_flag("--version", std::string("dynid ") + dynid::kVersion,
-                       "Print the version and exit");
+  app.set_version_flag(
+      "--version", std::string("dynid ") + dynid::kVersion + " (commit " + dynid::kGitCommit + ")",
+      "Print the version and the git commit it was built from, and exit");
   app.require_subcommand(1, 1);
   app.fallthrough(false);
   dynid::cli::add_commands(app);

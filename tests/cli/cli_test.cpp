@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -61,9 +63,22 @@ class Cli : public ::testing::Test {
 };
 
 TEST_F(Cli, Version) {
+  // The commit as git itself reports it for the checkout the tests were built from; a rebuild
+  // after a commit is needed for the two to agree, as for any other change.
+  std::string commit = "unknown";
+  if (std::FILE* git = ::popen(
+          ("git -C '" + std::string(DYNID_SOURCE_DIR) + "' rev-parse --short=12 HEAD 2>/dev/null")
+              .c_str(),
+          "r")) {
+    char line[64] = {};
+    if (std::fgets(line, sizeof line, git) && std::strlen(line) > 1) {
+      commit.assign(line, std::strcspn(line, "\n"));
+    }
+    ::pclose(git);
+  }
   const RunResult r = run("--version");
   EXPECT_EQ(r.code, 0);
-  EXPECT_EQ(r.out, std::string("dynid ") + kVersion + "\n");
+  EXPECT_EQ(r.out, std::string("dynid ") + kVersion + " (commit " + commit + ")\n");
 }
 
 TEST_F(Cli, HelpOnEveryCommandDocumentsEveryFlag) {
