@@ -4,20 +4,25 @@
 // output folder is a sibling of the project folder (ProjectOptions::output), so the output key of
 // the file is not followed outside the sandbox. The stages do not compute: the command table
 // registers a fixed set of flags like the real commands and its run() writes, through
-// write_text_atomic, every file the stage's arguments name as outputs.
+// write_file_atomic inside an OutputBatch (as the real commands do), every file the stage's
+// arguments name as outputs; an output named fail* makes the stage fail halfway through writing
+// it (the temporary-file path of a failing command).
 //
 // Invariants: the project folder is never written (its files keep their bytes, nothing appears in
 // it); every output a stage is asked to write is a plain file name (it lands in the output
-// folder); no `.partial` folder and no temporary file is left; an accepted project leaves a
-// folder with dynid's marker; the working directory is restored.
+// folder); a failing stage leaves no temporary file, checked before the runner removes its
+// `.partial` folder; no `.partial` folder and no temporary file is left anywhere in the sandbox;
+// an accepted project leaves a folder with dynid's marker; the working directory is restored.
 
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <ostream>
 #include <set>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "dynid/io/atomic_file.hpp"
@@ -27,6 +32,17 @@
 namespace {
 
 namespace fs = std::filesystem;
+
+// A name of write_file_atomic's temporary files (<name>.tmp.<pid>.<random>) anywhere in `folder`.
+bool has_temporary_file(const fs::path& folder) {
+  const std::string tmp = ".tmp." + std::to_string(::getpid()) + ".";
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(folder, ec);
+       !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+    if (it->path().filename().string().find(tmp) != std::string::npos) return true;
+  }
+  return false;
+}
 
 // command -> its flags: {name, takes a value, repeatable, writes}.
 const std::map<std::string, std::vector<dynid::CommandFlag>>& command_flags() {
@@ -67,16 +83,39 @@ dynid::CommandTable fake_table() {
   };
   table.run = [](const std::vector<std::string>& args) {
     const auto& flags = command_flags().at(args.at(0));
-    for (std::size_t i = 1; i + 1 < args.size(); ++i) {
-      if (args[i].rfind("--", 0) != 0) continue;
-      for (const auto& f : flags) {
-        if (!f.writes || "--" + f.name != args[i]) continue;
-        const std::string& name = args[i + 1];
-        dynid::fuzz::require(!name.empty() && name.find('/') == std::string::npos,
-                             "a stage output is not a plain file name in the output folder");
-        dynid::write_text_atomic(name, "written by " + args[0] + "\n");
+    std::string failure;
+    try {
+      dynid::OutputBatch batch;  // like the real commands: all outputs or none
+      for (std::size_t i = 1; i + 1 < args.size(); ++i) {
+        if (args[i].rfind("--", 0) != 0) continue;
+        for (const auto& f : flags) {
+          if (!f.writes || "--" + f.name != args[i]) continue;
+          const std::string& name = args[i + 1];
+          dynid::fuzz::require(!name.empty() && name.find('/') == std::string::npos,
+                               "a stage output is not a plain file name in the output folder");
+          dynid::write_file_atomic(name, [&](std::ostream& out) {
+            out << "written by " << args[0] << "\n";
+            // An output named fail* stands for a command that fails halfway through a file:
+            // bytes are already in its temporary file, and earlier outputs wait in the batch.
+            if (name.rfind("fail", 0) == 0) {
+              out.flush();
+              throw dynid::Error("failed while writing " + name);
+            }
+          });
+        }
       }
+      batch.commit();
+    } catch (const dynid::Error& e) {
+      failure = e.what();
     }
+    if (failure.empty()) return;
+    // Checked here, before the runner removes its .partial folder (the working directory): the
+    // writer and the batch themselves left no temporary file.
+    dynid::fuzz::require(dynid::temporary_files_in_flight() == 0,
+                         "a failed stage left a temporary file in flight");
+    dynid::fuzz::require(!has_temporary_file(fs::current_path()),
+                         "a failed stage left a temporary file in the output folder");
+    throw dynid::Error(failure);
   };
   return table;
 }
@@ -126,13 +165,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   dynid::fuzz::require(contents(project_dir) == before, "the project folder was written");
   dynid::fuzz::require(!fs::exists(sandbox / "out.partial"), "a .partial folder was left");
   dynid::fuzz::require(dynid::temporary_files_in_flight() == 0, "a temporary file is in flight");
+  dynid::fuzz::require(!has_temporary_file(sandbox), "a temporary file was left in the sandbox");
   if (accepted) {
     dynid::fuzz::require(fs::is_regular_file(output / ".dynid-run"), "no marker in the output");
-    for (const auto& e : fs::directory_iterator(output)) {
-      const std::string tmp = ".tmp." + std::to_string(::getpid()) + ".";
-      dynid::fuzz::require(e.path().filename().string().find(tmp) == std::string::npos,
-                           "a temporary file was left in the output folder");
-    }
   } else {
     dynid::fuzz::require(!fs::exists(output), "a refused project left an output folder");
   }

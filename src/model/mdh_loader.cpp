@@ -239,7 +239,8 @@ void read_mdh_table(const YAML::Node& doc, const Ctx& ctx, Model& model) {
   }
   if (rows.size() > static_cast<std::size_t>(kMaxJoints)) {
     ctx.fail("joints", "has " + std::to_string(rows.size()) + " rows; dynid handles at most " +
-                           std::to_string(kMaxJoints) + " joints");
+                           std::to_string(kMaxJoints) +
+                           " joints; split the model or make joints fixed");
   }
   std::map<std::string, std::size_t> row_of_name;
   Joint base_pose;  // R_PJ, p_PJ of the base placement

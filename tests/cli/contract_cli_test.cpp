@@ -16,10 +16,13 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "dynid/model/model.hpp"
+#include "support/chain_urdf.hpp"
 #include "support/cli_run.hpp"
 #include "support/planar2.hpp"
 
@@ -285,6 +288,8 @@ TEST_F(Contract, CorruptSampleIsRefusedOnEveryPath) {
       planar2_run("tau.csv", [](int k, double* row) { row[8] = k == 523 ? 1e200 : row[8]; });
   const std::string q =
       planar2_run("q.csv", [](int k, double* row) { row[1] = k == 523 ? 1e155 : row[1]; });
+  const std::string dq =
+      planar2_run("dq.csv", [](int k, double* row) { row[3] = k == 523 ? -1e150 : row[3]; });
   const std::string out = work("result.json");
   for (const std::string model : {"", "--stream --filter none", "--model friction --joint 1",
                                   "--model gravity --joint 1", "--model decoupled --joint 1"}) {
@@ -296,6 +301,11 @@ TEST_F(Contract, CorruptSampleIsRefusedOnEveryPath) {
     expect_error(run("identify --robot planar2 " + model + " --data " + q + " --out " + out), 1,
                  stream ? "'" + q + "' data row 524: q1 = 1e+155"
                         : "q1 at sample 524 (t = 5.23 s) = 1e+155 is a corrupt sample");
+    EXPECT_FALSE(fs::exists(out)) << model;
+    // A velocity column given in the file is screened as well (it is used as given).
+    expect_error(run("identify --robot planar2 " + model + " --data " + dq + " --out " + out), 1,
+                 stream ? "'" + dq + "' data row 524: dq1 = -1e+150"
+                        : "dq1 at sample 524 (t = 5.23 s) = -1e+150 is a corrupt sample");
     EXPECT_FALSE(fs::exists(out)) << model;
   }
   // validate's simulation statistics: the measured run is screened too.
@@ -339,6 +349,19 @@ TEST_F(Contract, FifoInputsAreRefusedNotWaitedOn) {
   expect_error(run("validate --robot planar2 --params " + fifo + " --data " + data), 1,
                "is not a regular file");
   EXPECT_FALSE(fs::exists(out));
+}
+
+// Issue 27 item 4: `report --in` read a result file of any size; it and `validate --params` have
+// the cap of every other JSON reader (a sparse file: nothing is really read).
+TEST_F(Contract, ResultFilesHaveTheSizeCap) {
+  const std::string huge = write("huge.json", "{}");
+  fs::resize_file(huge, (std::size_t{256} << 20) + 1);
+  const std::string html = work("r.html");
+  expect_error(run("report --in " + huge + " --out " + html), 1,
+               "'" + huge + "' is larger than 256 MiB");
+  EXPECT_FALSE(fs::exists(html));
+  expect_error(run("validate --robot planar2 --params " + huge + " --data " + planar2_run("r.csv")),
+               1, "'" + huge + "' is larger than 256 MiB");
 }
 
 // Issue 27 item 3: a mimic joint was silently a free joint with its own parameters.
@@ -458,6 +481,19 @@ TEST_F(Contract, FailedDemoLeavesNoFileBehind) {
   const CliRun r = run("demo --robot " + work("no_such_robot.urdf") + " --out " + folder);
   EXPECT_EQ(r.code, 1) << r.err;
   EXPECT_FALSE(fs::exists(folder));
+  // A demo that fails at stage 4 of 6, after the excitation, the run, the averaged run and the
+  // result were written: a folder stands where its validation run goes. None of those files
+  // appears in the user's folder, which keeps exactly what it held.
+  fs::create_directories(work("demo/validation_run.csv"));
+  write("demo/notes.txt", "mine\n");
+  // (validation_run.csv is the demo's sixth file: workflow/demo.cpp writes it after result.json.)
+  const CliRun late = run("demo --robot planar2 --native --periods 3 --quiet --out " + folder);
+  expect_error(late, 1, "validation_run.csv' is a directory");
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(folder)) left.push_back(e.path().filename());
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"notes.txt", "validation_run.csv"}));
+  EXPECT_EQ(slurp(work("demo/notes.txt")), "mine\n");
 }
 
 // Issue 27 item 5: yaml-cpp's "bad conversion" reached the user as the reason.
@@ -470,6 +506,43 @@ joints:
   const CliRun r = run("model --robot " + robot);
   expect_error(r, 1, "a value has the wrong type");
   EXPECT_EQ(r.err.find("bad conversion"), std::string::npos) << r.err;
+}
+
+// Issue 27 item 4: `model --base` at the old 5000-joint limit took 100 s and 7.6 GB (a chain's
+// regrouping is transitive: O(n²) terms). The limit came down to 1000 joints, where it takes
+// seconds (docs/performance.md); one more joint is one error line naming the file and the limit,
+// from either loader, before any work. The base parameters at the limit itself are computed in
+// BaseParametersTree.ThousandJointChainLoadsAndGetsItsBaseParameters (library, no 77 MB of
+// expressions to print); here a 200-joint chain goes through the command.
+TEST_F(Contract, JointLimitIsOneErrorLineAndModelBaseBelowItFinishes) {
+  const std::string limit = std::to_string(kMaxJoints);
+  // The documented limit is the one the loaders apply.
+  const std::string docs = slurp(fs::path(DYNID_SOURCE_DIR) / "docs" / "cli.md");
+  EXPECT_NE(docs.find("| moving joints per model (URDF or YAML rows) | " + limit + " |"),
+            std::string::npos);
+
+  const std::string urdf = write("long.urdf", testing::chain_urdf(kMaxJoints + 1, 4));
+  expect_error(run("model --base --robot " + urdf), 1,
+               "robot file '" + urdf + "' has more than " + limit + " moving joints");
+  std::string rows = "joints:\n";
+  for (int j = 0; j <= kMaxJoints; ++j)
+    rows += "  - {sigma: 0, alpha: 0, d: 0.1, theta: 0, r: 0}\n";
+  const std::string mdh = write("long.yaml", rows);
+  expect_error(run("model --robot " + mdh), 1,
+               "robot file '" + mdh + "': joints: has " + std::to_string(kMaxJoints + 1) +
+                   " rows; dynid handles at most " + limit + " joints");
+
+  const std::string at_limit = write("limit.urdf", testing::chain_urdf(kMaxJoints, 4));
+  const CliRun loaded = run("model --robot " + at_limit);
+  EXPECT_EQ(loaded.code, 0) << loaded.err;
+  // The dense sweep finds 80 = 7·12 − 4 base parameters on the first 12 links of this chain, and
+  // each further generic revolute link adds 7 (BaseParametersTree tests): 7·200 − 4.
+  const std::string chain = write("chain200.urdf", testing::chain_urdf(200, 11));
+  const std::string json = work("model.json");
+  const CliRun base = run("model --base --robot " + chain + " --json " + json);
+  ASSERT_EQ(base.code, 0) << base.err;
+  EXPECT_NE(base.out.find("1396 base parameters"), std::string::npos) << base.out.substr(0, 400);
+  EXPECT_EQ(nlohmann::json::parse(slurp(json)).at("rank"), 1396);
 }
 
 }  // namespace

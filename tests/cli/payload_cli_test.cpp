@@ -219,6 +219,7 @@ TEST_F(PayloadCli, RecursiveEstimatorWritesItsHistory) {
                            " --sensor-pose '0.01 0 0.05 0 0 0.3' --estimator rls --history " +
                            path("missing/history.csv") + " --out " + path("load.json"));
   expect_error(missing, 1, "missing");
+  EXPECT_FALSE(fs::exists(dir_ / "load.json"));
   // --report: a page headless Chromium renders without a script error or an empty chart.
   const testing::RenderedReport page = testing::render_in_chromium(path("load.html"), dir_);
   ASSERT_EQ(page.sections.size(), 1u) << page.log;
@@ -485,6 +486,12 @@ TEST_F(PayloadCli, BadInputsGiveOneErrorLine) {
   expect_error(run("payload --data " + path("run.csv") + out), 1, "qx qy qz qw");
   expect_error(run(robot + path("run.csv") + " --model energy"), 2, "--model");
   expect_error(run(robot + path("run.csv") + " --history " + path("h.csv")), 2, "rls");
+  // Issue 27 item 5: the level was named by its C++ field (EstimationOptions::confidence_level).
+  const auto level = run(robot + path("run.csv") + " --confidence 1.5");
+  expect_error(level, 1,
+               "1.5 is outside (0, 1); give a level such as 0.95 or 0.999 (--confidence)");
+  EXPECT_EQ(level.err.find("::"), std::string::npos) << level.err;
+  EXPECT_FALSE(fs::exists(dir_ / "load.json"));
 }
 
 // Issue 26 item 2: payload reads its run with the run flags every command takes. A run without t

@@ -296,8 +296,10 @@ TEST(BaseParametersTree, EqualsTheDenseSweepOnSpecialGeometry) {
 // on states the computation never saw (a regressor row of the full model is the oracle); (2) the
 // regrouping is local, so the count grows by exactly 7 per generic revolute link (10 parameters,
 // 3 regrouped into the parent: Khalil & Dombre, "Modeling, Identification and Control of Robots",
-// 2002, §9.5), compared with the dense sweep on the first 12 links.
+// 2002, §9.5), compared with the dense sweep on the first 12 links. 1000 joints is the limit of
+// every loader (kMaxJoints, issue 27 item 4): the largest model that can reach this computation.
 TEST(BaseParametersTree, ThousandJointChainLoadsAndGetsItsBaseParameters) {
+  static_assert(kMaxJoints == 1000, "the chain below is at the joint limit");
   const Model model = parse_urdf(testing::chain_urdf(1000, 11), "chain1000.urdf");
   ASSERT_EQ(model.dof(), 1000);
   const BaseParameters bp = compute_base_parameters(model);

@@ -2,11 +2,12 @@
 // rename that never replaces a FIFO, socket or device, a symbolic link at the target replaced and
 // not written through, the usual permissions, and SIGINT/SIGTERM/SIGHUP removing the temporary
 // file before the process ends with that signal. Special files are made in the test's own
-// folder (a FIFO, a socket); /dev is never touched.
+// folder (a FIFO, a socket, a device node, a link to /dev/null); /dev is never written.
 #include "dynid/io/atomic_file.hpp"
 
 #include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -126,6 +127,35 @@ TEST(AtomicFile, RefusesToReplaceAFifoOrASocket) {
   }
   ::close(fd);
   EXPECT_HAS(error_of([&] { check_output_target(fifo, "--out"); }), "--out '");
+  EXPECT_EQ(temporary_files_in_flight(), 0);
+}
+
+// As root, `-o /dev/null` replaced the system's /dev/null. Through a link in the test's folder
+// (were the check missing, the rename would replace the link, never /dev/null itself), and as a
+// character device made in the test's folder where the process may create one (root).
+TEST(AtomicFile, RefusesToReplaceADeviceNode) {
+  TempDir dir;
+  fs::create_symlink("/dev/null", dir.file("null"));
+  bool called = false;
+  const std::string m = error_of([&] {
+    write_file_atomic(dir.file("null"), [&](std::ostream& out) {
+      called = true;
+      out << "x";
+    });
+  });
+  EXPECT_HAS(m, "null' is a character device, not a regular file");
+  EXPECT_FALSE(called);  // refused before any work
+  EXPECT_TRUE(fs::is_symlink(dir.file("null")));
+  EXPECT_HAS(error_of([&] { check_output_target("/dev/null", "-o"); }), "a character device");
+  EXPECT_EQ(dir.entries(), 1);
+  const std::string node = dir.file("device");
+  if (::mknod(node.c_str(), S_IFCHR | 0600, makedev(1, 3)) != 0) {
+    GTEST_SKIP() << "mknod is not permitted here (" << std::strerror(errno)
+                 << "); the link case above ran";
+  }
+  EXPECT_HAS(error_of([&] { write_text_atomic(node, "x"); }), "device' is a character device");
+  EXPECT_TRUE(fs::is_character_file(node));
+  EXPECT_EQ(dir.entries(), 2);
   EXPECT_EQ(temporary_files_in_flight(), 0);
 }
 

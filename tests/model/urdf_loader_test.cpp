@@ -320,16 +320,16 @@ TEST(UrdfLoaderErrors, CycleBelowTheRoot) {
   EXPECT_EQ(out, "");
 }
 
-// Issue 10: a chain of ~12 000 links overflowed the stack of the recursive builder. 4000 moving
-// joints, each followed by two fixed links: 12 000 links deep.
+// Issue 10: a chain of ~12 000 links overflowed the stack of the recursive builder. 1000 moving
+// joints (kMaxJoints), each followed by eleven fixed links: 12 000 links deep.
 TEST(UrdfLoader, TwelveThousandLinksDeepLoadIteratively) {
-  const Model model = parse_urdf(testing::chain_urdf(4000, 3, 2), "deep.urdf");
-  ASSERT_EQ(model.dof(), 4000);
-  EXPECT_EQ(model.joints[3999].parent, 3998);
-  // Each moving link (1 to 2 kg) carries its two fixed bodies of 0.01 kg.
+  const Model model = parse_urdf(testing::chain_urdf(1000, 3, 11), "deep.urdf");
+  ASSERT_EQ(model.dof(), 1000);
+  EXPECT_EQ(model.joints[999].parent, 998);
+  // Each moving link (1 to 2 kg) carries its eleven fixed bodies of 0.01 kg.
   for (int j = 0; j < model.dof(); ++j) {
-    EXPECT_GE(model.links[j](9), 1.02 - 1e-12) << j;
-    EXPECT_LE(model.links[j](9), 2.02 + 1e-12) << j;
+    EXPECT_GE(model.links[j](9), 1.11 - 1e-12) << j;
+    EXPECT_LE(model.links[j](9), 2.11 + 1e-12) << j;
   }
   EXPECT_TRUE(model.transmission.is_identity());
 }

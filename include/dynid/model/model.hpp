@@ -14,9 +14,11 @@ enum class JointType { kRevolute, kPrismatic };
 /// Number of standard inertial parameters per link (docs/design.md section 3).
 inline constexpr int kLinkParams = 10;
 
-/// Largest number of moving joints a model may have (docs/cli.md, "Input size limits"): the dense
-/// n×n transmission matrix alone takes 8·n² bytes, 200 MB at this limit.
-inline constexpr int kMaxJoints = 5000;
+/// Largest number of moving joints a model may have (docs/cli.md, "Input size limits"). The
+/// regrouping of a chain is transitive, so its base-parameter expressions and K_d hold O(n²) terms:
+/// `model --base` of a 1000-joint chain takes 6 s and 0.7 GB, of 2000 joints 22 s and 2.6 GB, of
+/// 5000 joints 100 s and 7.6 GB (docs/performance.md). Every identification needs them.
+inline constexpr int kMaxJoints = 1000;
 
 /// Standard inertial parameters of one link, in link frame j, about the link ORIGIN, in the order
 /// XX XY XZ YY YZ ZZ MX MY MZ M (kg·m², kg·m, kg). MX = m·c_x.
