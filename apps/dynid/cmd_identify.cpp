@@ -24,6 +24,7 @@
 #include "dynid/identification/validation.hpp"
 #include "dynid/io/closed_loop_file.hpp"
 #include "dynid/io/joint_record_file.hpp"
+#include "dynid/io/joint_state_log.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/io/model_summary.hpp"
 #include "dynid/model/robots.hpp"
@@ -445,6 +446,11 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   require_output_folder(o.out, "--out");
   require_output_folder(o.history, "--history");
   require_output_folder(o.report, "--report");
+  if (o.stream && !o.runs.empty() &&
+      joint_state_log_format(o.runs.front()) != JointStateLogFormat::kNone) {
+    throw UsageError("--stream reads a CSV run in chunks; '" + o.runs.front() +
+                     "' is a ROS log, read in memory: drop --stream");
+  }
   if (o.stream && (!o.run.torque_scale.empty() || !file.torque_bias.empty() ||
                    !file.window.empty() || columns_by_position(file.columns))) {
     throw UsageError(
