@@ -332,8 +332,8 @@ void run_experiment(const IdentifyCliOptions& o, const IdentifyOptions& options,
   if (options.estimator != IdentificationEstimator::kOls) {
     throw UsageError("--model " + o.model + " fits by least squares; drop --estimator");
   }
-  const Model model =
-      load_cli_robot(o.robot, o.robot_flags, {"identify", o.runs, file.columns, {}, ""});
+  const Model model = load_cli_robot(o.robot, o.robot_flags,
+                                     {"identify", o.runs, file.columns, {}, "", file.topic});
   if (o.joint < 1 || o.joint > model.dof()) {
     throw UsageError("--joint " + std::to_string(o.joint) + " is not a joint of '" + model.name +
                      "'; give 1 to " + std::to_string(model.dof()));
@@ -478,8 +478,8 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     run_experiment(o, options, file);
     return;
   }
-  const Model model =
-      load_cli_robot(o.robot, o.robot_flags, {"identify", o.runs, file.columns, {}, ""});
+  const Model model = load_cli_robot(o.robot, o.robot_flags,
+                                     {"identify", o.runs, file.columns, {}, "", file.topic});
   RunFileReport read;
   IdentificationResult result;
   RepeatedEstimate repeated;
@@ -635,9 +635,9 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
     }
   }
   const IdentifiedResultFile identified = read_identification_result(v.params);
-  const Model model =
-      load_cli_robot(v.robot, v.robot_flags,
-                     {"validate", {v.data}, file.columns, selection_stored_in(v.params), v.params});
+  const Model model = load_cli_robot(
+      v.robot, v.robot_flags,
+      {"validate", {v.data}, file.columns, selection_stored_in(v.params), v.params, file.topic});
   require_same_robot(identified.robot, model.name, "'" + v.params + "'",
                      "validate with the robot the parameters were identified on");
   std::vector<std::string> names = identified.names;

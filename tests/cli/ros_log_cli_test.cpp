@@ -4,6 +4,7 @@
 // in messages that name the joints in another order than the model and carry epoch stamps; the
 // result must equal that of the same numbers written as a t,q_<joint>,dq_<joint>,tau_<joint>
 // CSV (to 1e-9), which is itself within 1e-3 of the closed form's ZZ1R.
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -156,6 +157,59 @@ TEST_F(RosLogCli, IdentifyFromRostopicAndPlotJugglerCsv) {
   EXPECT_NE(echo.find("rostopic echo -p output"), std::string::npos) << echo;
   expect_as_csv(path("pj.csv"), "", &echo);
   EXPECT_NE(echo.find("PlotJuggler CSV"), std::string::npos) << echo;
+}
+
+// A log of some of the robot's joints (an arm's driver, a robot file with more joints): the
+// joints the messages do not name are held at 0, as for a CSV header naming some joints.
+// Oracle: the shoulder alone moving, the elbow at 0, from the closed form; the merged link's ZZ
+// about the shoulder is I1 + m1·c1² + I2 + m2·(l1 + c2)².
+TEST_F(RosLogCli, ABagOfSomeJointsLocksTheOthers) {
+  dynid::testing::Planar2 arm;
+  arm.I1 = 2.0 / 12;
+  arm.I2 = 1.5 * 0.64 / 12;
+  std::vector<dynid::testing::TestLogEntry> entries;
+  std::ofstream csv(path("shoulder.csv"));
+  csv << "t,q_shoulder,dq_shoulder,tau_shoulder\n";
+  for (int k = 0; k < kRosCliSamples; ++k) {
+    const dynid::testing::Planar2Sample s = dynid::testing::planar2_sample(k, kRosCliDt);
+    TestJointState m;
+    m.stamp_ns = kRosCliEpochNs + 10'000'000LL * k;
+    m.name = {"shoulder"};
+    m.position = {s.q[0]};
+    m.velocity = {s.dq[0]};
+    m.effort = {arm.torque({s.q[0], 0.0}, {s.dq[0], 0.0}, {s.ddq[0], 0.0})[0]};
+    entries.push_back({"/joint_states", m.stamp_ns, m});
+    char line[200];
+    std::snprintf(line, sizeof(line), "%.17g,%.17g,%.17g,%.17g\n",
+                  static_cast<double>(m.stamp_ns - kRosCliEpochNs) * 1e-9, m.position[0],
+                  m.velocity[0], m.effort[0]);
+    csv << line;
+  }
+  csv.close();
+  dynid::testing::write_ros1_bag(path("shoulder.bag"), entries);
+  nlohmann::json result[2];
+  for (int i = 0; i < 2; ++i) {
+    const RosCliRun id =
+        run("identify --robot planar2 --data " + path(i ? "shoulder.csv" : "shoulder.bag") +
+            " --filter none --friction none --no-armature --out " + path("result.json"));
+    ASSERT_EQ(id.code, 0) << id.err;
+    EXPECT_NE(id.err.find("locked joints"), std::string::npos) << id.err;
+    EXPECT_NE(id.err.find("elbow=0"), std::string::npos) << id.err;
+    result[i] = nlohmann::json::parse(std::ifstream(path("result.json")));
+  }
+  ASSERT_EQ(result[0]["parameters"].size(), result[1]["parameters"].size());
+  bool zz = false;
+  for (std::size_t p = 0; p < result[0]["parameters"].size(); ++p) {
+    const auto& a = result[0]["parameters"][p];
+    EXPECT_EQ(a["name"], result[1]["parameters"][p]["name"]);
+    EXPECT_NEAR(a["value"].get<double>(), result[1]["parameters"][p]["value"].get<double>(),
+                1e-9 * (1 + std::abs(a["value"].get<double>())));
+    if (a["name"].get<std::string>().rfind("ZZ1", 0) == 0) {
+      zz = true;
+      EXPECT_NEAR(a["value"].get<double>(), 2.0 / 12 + 2.0 * 0.25 + 0.08 + 1.5 * 1.4 * 1.4, 1e-3);
+    }
+  }
+  EXPECT_TRUE(zz) << result[0].dump();
 }
 
 // A log without efforts cannot be identified: the error names the topic and the field.
