@@ -225,6 +225,7 @@ nlohmann::json echo(const IdentifyCliOptions& o) {
           {"columns", o.run.columns},
           {"torque_scale", o.run.torque_scale},
           {"torque_bias", o.run.torque_bias},
+          {"topic", o.run.topic},
           {"rows", o.run.rows},
           {"time", o.run.time},
           {"friction_known", o.friction_known},
@@ -650,6 +651,7 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
   overrides.columns_given = run_flag_given(cmd, "--columns");
   overrides.rate_given = run_flag_given(cmd, "--rate");
   overrides.torque_bias_given = run_flag_given(cmd, "--torque-bias");
+  overrides.topic_given = run_flag_given(cmd, "--topic");
   if (run_flag_given(cmd, "--time-shift")) overrides.time_shift = v.run.shift();
   const StoredIdentifyOptions stored =
       options_of_stored_result(identified, v.params, model.dof(), overrides);

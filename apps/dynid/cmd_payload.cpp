@@ -143,6 +143,7 @@ void run_payload_from_result(const PayloadCliOptions& cli, const CLI::App& cmd,
   overrides.columns_given = run_flag_given(cmd, "--columns");
   overrides.rate_given = run_flag_given(cmd, "--rate");
   overrides.torque_bias_given = run_flag_given(cmd, "--torque-bias");
+  overrides.topic_given = run_flag_given(cmd, "--topic");
   if (run_flag_given(cmd, "--time-shift")) overrides.time_shift = cli.run.shift();
   const StoredIdentifyOptions stored =
       options_of_stored_result(identified, cli.reference, model.dof(), overrides);

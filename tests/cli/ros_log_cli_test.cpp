@@ -159,6 +159,39 @@ TEST_F(RosLogCli, IdentifyFromRostopicAndPlotJugglerCsv) {
   EXPECT_NE(echo.find("PlotJuggler CSV"), std::string::npos) << echo;
 }
 
+// validate reads the topic identify read (stored in the result), unless --topic says otherwise.
+TEST_F(RosLogCli, ValidateReadsTheTopicIdentifyRead) {
+  std::vector<dynid::testing::TestLogEntry> entries;
+  for (int k = 0; k < kRosCliSamples; ++k) {
+    const TestJointState m = ros_cli_message(k);
+    entries.push_back({"/right/joint_states", m.stamp_ns, m});
+    TestJointState other = m;
+    for (double& x : other.effort) x *= 2;  // another arm: not what the parameters predict
+    entries.push_back({"/left/joint_states", m.stamp_ns + 1, other});
+  }
+  dynid::testing::write_ros1_bag(path("two.bag"), entries);
+  const std::string result = path("result.json");
+  const RosCliRun id = run("identify --robot planar2 --data " + path("two.bag") +
+                           " --topic /right/joint_states --filter none --friction none "
+                           "--no-armature --out " +
+                           result);
+  ASSERT_EQ(id.code, 0) << id.err;
+  EXPECT_NEAR(zz1r(result), kRosCliZz1r, 1e-3);
+  const std::string val = path("val.json");
+  const RosCliRun v = run("validate --robot planar2 --params " + result + " --data " +
+                          path("two.bag") + " --json " + val);
+  ASSERT_EQ(v.code, 0) << v.err;
+  EXPECT_NE(v.err.find("--topic as given to identify"), std::string::npos) << v.err;
+  EXPECT_LT(nlohmann::json::parse(std::ifstream(val))["relative_error_all_rows"].get<double>(),
+            1e-5);
+  // The other arm, by --topic: half its torque unexplained.
+  const RosCliRun left = run("validate --robot planar2 --params " + result + " --data " +
+                             path("two.bag") + " --topic /left/joint_states --json " + val);
+  ASSERT_EQ(left.code, 0) << left.err;
+  EXPECT_NEAR(nlohmann::json::parse(std::ifstream(val))["relative_error_all_rows"].get<double>(),
+              0.5, 1e-3);
+}
+
 // A log of some of the robot's joints (an arm's driver, a robot file with more joints): the
 // joints the messages do not name are held at 0, as for a CSV header naming some joints.
 // Oracle: the shoulder alone moving, the elbow at 0, from the closed form; the merged link's ZZ
