@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -94,13 +95,20 @@ double field_number(const std::string& s, const std::string& at, const std::stri
   return x;
 }
 
-std::int64_t field_integer(const std::string& s, const std::string& at, const std::string& column) {
-  if (!is_integer(s)) {
-    throw Error(at + ": " + column + " '" + printable(s) +
-                "' is not a non-negative integer; fix or remove the line");
+// A non-negative integer field no greater than `max` (stamps: nanoseconds, seconds, nanosec).
+std::int64_t field_integer(const std::string& s, const std::string& at, const std::string& column,
+                           std::int64_t max) {
+  std::int64_t x = -1;
+  const auto r = std::from_chars(s.data(), s.data() + s.size(), x);
+  if (!is_integer(s) || r.ec != std::errc() || r.ptr != s.data() + s.size() || x > max) {
+    throw Error(at + ": " + column + " '" + printable(s) + "' is not an integer from 0 to " +
+                std::to_string(max) + "; fix or remove the line");
   }
-  return std::stoll(s);
+  return x;
 }
+
+// Largest stamp [ns] a CSV line may give: ROS times are 32-bit seconds.
+constexpr std::int64_t kMaxStampNs = 4'294'967'296LL * 1'000'000'000;
 
 // `rostopic echo -p` output: `%time` (receive time, ns), field.header.stamp (ns), string fields,
 // then field.name<i>, field.position<i>, field.velocity<i>, field.effort<i>, one per array item
@@ -139,8 +147,8 @@ JointStateLog read_rostopic_csv(const std::string& path) {
                   "columns after the first message): record a bag instead");
     }
     JointStateMessage m;
-    m.stamp_ns = field_integer(f[stamp], at, "field.header.stamp");
-    m.record_ns = time < f.size() ? field_integer(f[time], at, "%time") : m.stamp_ns;
+    m.stamp_ns = field_integer(f[stamp], at, "field.header.stamp", kMaxStampNs);
+    m.record_ns = time < f.size() ? field_integer(f[time], at, "%time", kMaxStampNs) : m.stamp_ns;
     for (const std::size_t c : arrays["name"]) m.name.push_back(f[c]);
     for (const auto& [a, v] :
          {std::pair{"position", &m.position}, std::pair{"velocity", &m.velocity},
@@ -180,8 +188,9 @@ JointStateLog read_ros2_echo_csv(const std::string& path) {
                   "record a bag instead");
     }
     JointStateMessage m;
-    const std::int64_t nanosec = field_integer(f[1], at, "nanosec");
-    m.stamp_ns = field_integer(f[0], at, "sec") * 1'000'000'000 + nanosec;
+    const std::int64_t nanosec = field_integer(f[1], at, "nanosec", 999'999'999);
+    m.stamp_ns =
+        field_integer(f[0], at, "sec", kMaxStampNs / 1'000'000'000) * 1'000'000'000 + nanosec;
     m.record_ns = m.stamp_ns;
     m.name.assign(f.begin() + 3, f.begin() + 3 + static_cast<long>(n));
     std::size_t c = 3 + n;
