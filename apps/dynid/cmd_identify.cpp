@@ -86,6 +86,8 @@ void require_readable(const std::string& path, const char* flag) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (fs::is_directory(path, ec)) {
+    // A ROS 2 bag is a folder (the library reads its .db3 files).
+    if (joint_state_log_format(path) != JointStateLogFormat::kNone) return;
     throw Error(std::string(flag) + " '" + path + "' is a folder; give the file");
   }
   require_regular_file(path, flag);  // opening a FIFO to test it would wait for a writer

@@ -299,7 +299,15 @@ JointStateLogFormat joint_state_log_format(const std::string& path) {
   if (ends_with(path, ".db3")) return JointStateLogFormat::kRosbag2Sqlite;
   // Opening a FIFO or a device would block or never end: the CSV reader names those.
   struct stat st {};
-  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return JointStateLogFormat::kNone;
+  if (::stat(path.c_str(), &st) != 0) return JointStateLogFormat::kNone;
+  if (S_ISDIR(st.st_mode)) {
+    // A ROS 2 bag is a folder: metadata.yaml and its storage files.
+    return !ros_detail::rosbag2_storage_files(path).empty() ||
+                   ::stat((path + "/metadata.yaml").c_str(), &st) == 0
+               ? JointStateLogFormat::kRosbag2Sqlite
+               : JointStateLogFormat::kNone;
+  }
+  if (!S_ISREG(st.st_mode)) return JointStateLogFormat::kNone;
   std::ifstream in(path, std::ios::binary);
   std::string first;
   // Only the first line decides; a line of a CSV run is far shorter than this.

@@ -69,8 +69,11 @@ JointStateLog joint_state_table(std::vector<JointStateMessage>& messages, const 
 /// a record (an interrupted recording) is read up to it, with a warning.
 TopicMessages read_rosbag1(const std::string& path, const std::string& topic);
 
-/// ROS 2 sqlite3 bag reader: the JointState messages of `topic` (choose_topic()), in
-/// record-time order.
+/// The sqlite3 storage files (`*.db3`) of the ROS 2 bag folder `folder`, sorted; empty when none.
+std::vector<std::string> rosbag2_storage_files(const std::string& folder);
+
+/// ROS 2 sqlite3 bag reader: the JointState messages of `topic` (choose_topic()) in record-time
+/// order, from the `.db3` file `path` or every `.db3` file of the bag folder `path` (a split bag).
 TopicMessages read_rosbag2_sqlite(const std::string& path, const std::string& topic);
 
 }  // namespace dynid::ros_detail

@@ -6,6 +6,7 @@
 // CSV (to 1e-9), which is itself within 1e-3 of the closed form's ZZ1R.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -123,9 +124,13 @@ TEST_F(RosLogCli, IdentifyFromARos2Bag) {
     const TestJointState m = ros_cli_message(k);
     records.push_back({0, m.stamp_ns + 1'000'000, dynid::testing::cdr_joint_state(m)});
   }
-  dynid::testing::write_ros2_db3(path("run.db3"), {{"/joint_states", "sensor_msgs/msg/JointState"}},
-                                 records);
-  expect_as_csv(path("run.db3"));
+  // The bag folder as ros2 bag record writes it, given as the folder and as its .db3 file.
+  std::filesystem::create_directories(path("bag"));
+  std::ofstream(path("bag/metadata.yaml")) << "rosbag2_bagfile_information:\n";
+  dynid::testing::write_ros2_db3(path("bag/bag_0.db3"),
+                                 {{"/joint_states", "sensor_msgs/msg/JointState"}}, records);
+  expect_as_csv(path("bag"));
+  expect_as_csv(path("bag/bag_0.db3"));
 }
 
 TEST_F(RosLogCli, IdentifyFromRostopicAndPlotJugglerCsv) {

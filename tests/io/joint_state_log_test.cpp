@@ -359,6 +359,34 @@ TEST(RosLog, Ros2CdrEveryPaddingBothByteOrders) {
   }
 }
 
+// A ROS 2 bag is a folder; a split bag has several storage files, read together in time order.
+TEST(RosLog, Ros2BagFolderWithSplitStorage) {
+  test::TempDir dir;
+  const std::filesystem::path folder = dir.path() / "rosbag2_2024_12_07-14_00_00";
+  std::filesystem::create_directories(folder);
+  std::ofstream(folder / "metadata.yaml") << "rosbag2_bagfile_information:\n  version: 5\n";
+  std::vector<testing::TestRecord> first, second;
+  for (int k = 0; k < kRosMessages; ++k) {
+    const TestJointState m = ros_message(k);
+    (k < kRosMessages / 2 ? first : second).push_back({0, m.stamp_ns, testing::cdr_joint_state(m)});
+  }
+  testing::write_ros2_db3((folder / "rosbag2_0.db3").string(), {kJointStatesTopic}, first);
+  testing::write_ros2_db3((folder / "rosbag2_1.db3").string(), {kJointStatesTopic}, second);
+  ASSERT_EQ(joint_state_log_format(folder.string()), JointStateLogFormat::kRosbag2Sqlite);
+  const JointStateLog log =
+      read_joint_state_log(folder.string(), JointStateLogFormat::kRosbag2Sqlite, "");
+  expect_ros_table(log.table);
+  EXPECT_TRUE(has_text(log.notes, "2 storage files of a split bag read"));
+  // A folder of another storage (MCAP) is named.
+  const std::filesystem::path mcap = dir.path() / "mcap_bag";
+  std::filesystem::create_directories(mcap);
+  std::ofstream(mcap / "metadata.yaml") << "rosbag2_bagfile_information:\n";
+  EXPECT_HAS(error_of([&] {
+               read_joint_state_log(mcap.string(), JointStateLogFormat::kRosbag2Sqlite, "");
+             }),
+             "has no .db3 file");
+}
+
 TEST(RosLog, Ros2BadBagsAreOneError) {
   test::TempDir dir;
   // Not a database.

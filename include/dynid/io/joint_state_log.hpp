@@ -18,13 +18,14 @@ inline constexpr std::size_t kMaxJointStateValues = std::size_t{1} << 27;  ///< 
 enum class JointStateLogFormat {
   kNone,           ///< not a ROS log: a plain CSV run (docs/design.md §4)
   kRosbag1,        ///< ROS 1 bag (`.bag`, format 2.0; chunks plain, bz2 or lz4)
-  kRosbag2Sqlite,  ///< ROS 2 bag in sqlite3 storage (`.db3`), messages in CDR
+  kRosbag2Sqlite,  ///< ROS 2 bag in sqlite3 storage (`.db3`, or its folder), messages in CDR
   kRostopicCsv,    ///< `rostopic echo -p` output: header `%time,field.header.seq,...`
   kRos2EchoCsv,    ///< `ros2 topic echo --csv` output: no header, sec,nanosec,frame_id,names,...
   kPlotJugglerCsv  ///< PlotJuggler CSV export: `__time`, `<topic>/<joint>/position` ...
 };
 
-/// The format of the run file `path`: by extension for bags (`.bag`, `.db3`), else by the first
+/// The format of the run file `path`: by extension for bags (`.bag`, `.db3`; a folder with `.db3`
+/// files or a metadata.yaml is a ROS 2 bag), else by the first
 /// line of the text (`%time,field.` for rostopic, a `__time` column for PlotJuggler, two integers
 /// followed by a name for ros2 topic echo); kNone for anything else, including a file that cannot
 /// be read (the CSV reader then reports why). Reads at most the first line. Never throws.
