@@ -44,7 +44,7 @@ void add_run_flags(CLI::App* cmd, RunFlags& flags, RunFlagDefaults defaults) {
                       stored);
   cmd->add_option("--topic", flags.topic,
                   "sensor_msgs/JointState topic of a ROS log given as the run (.bag, .db3, "
-                  "PlotJuggler CSV); default /joint_states, or the log's only JointState topic" +
+                  "PlotJuggler export); default /joint_states, or the log's only JointState topic" +
                       stored);
 }
 
