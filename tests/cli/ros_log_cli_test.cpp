@@ -109,6 +109,9 @@ TEST_F(RosLogCli, IdentifyAndValidateFromARos1Bag) {
   }
   EXPECT_LT(error[0], 1e-5);
   EXPECT_NEAR(error[0], error[1], 1e-9);
+  // --stream reads CSV in chunks; a log is read in memory, and the flag is refused.
+  expect_error(run("identify --robot planar2 --data " + bag + " --stream --out " + path("x.json")),
+               2, {"--stream", "is a ROS log", "drop --stream"});
   // Another topic, chosen with --topic; a wrong one is one error line naming the topics.
   const std::string arm = write_bag("arm.bag", "/arm/joint_states");
   expect_as_csv(arm, " --topic /arm/joint_states");
