@@ -24,6 +24,7 @@
 #include "dynid/identification/validation.hpp"
 #include "dynid/io/closed_loop_file.hpp"
 #include "dynid/io/joint_record_file.hpp"
+#include "dynid/io/joint_state_log.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/io/model_summary.hpp"
 #include "dynid/model/robots.hpp"
@@ -85,6 +86,8 @@ void require_readable(const std::string& path, const char* flag) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (fs::is_directory(path, ec)) {
+    // A ROS 2 bag is a folder (the library reads its .db3 files).
+    if (joint_state_log_format(path) != JointStateLogFormat::kNone) return;
     throw Error(std::string(flag) + " '" + path + "' is a folder; give the file");
   }
   require_regular_file(path, flag);  // opening a FIFO to test it would wait for a writer
@@ -224,6 +227,7 @@ nlohmann::json echo(const IdentifyCliOptions& o) {
           {"columns", o.run.columns},
           {"torque_scale", o.run.torque_scale},
           {"torque_bias", o.run.torque_bias},
+          {"topic", o.run.topic},
           {"rows", o.run.rows},
           {"time", o.run.time},
           {"friction_known", o.friction_known},
@@ -331,8 +335,8 @@ void run_experiment(const IdentifyCliOptions& o, const IdentifyOptions& options,
   if (options.estimator != IdentificationEstimator::kOls) {
     throw UsageError("--model " + o.model + " fits by least squares; drop --estimator");
   }
-  const Model model =
-      load_cli_robot(o.robot, o.robot_flags, {"identify", o.runs, file.columns, {}, ""});
+  const Model model = load_cli_robot(o.robot, o.robot_flags,
+                                     {"identify", o.runs, file.columns, {}, "", file.topic});
   if (o.joint < 1 || o.joint > model.dof()) {
     throw UsageError("--joint " + std::to_string(o.joint) + " is not a joint of '" + model.name +
                      "'; give 1 to " + std::to_string(model.dof()));
@@ -445,6 +449,11 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   require_output_folder(o.out, "--out");
   require_output_folder(o.history, "--history");
   require_output_folder(o.report, "--report");
+  if (o.stream && !o.runs.empty() &&
+      joint_state_log_format(o.runs.front()) != JointStateLogFormat::kNone) {
+    throw UsageError("--stream reads a CSV run in chunks; '" + o.runs.front() +
+                     "' is a ROS log, read in memory: drop --stream");
+  }
   if (o.stream && (!o.run.torque_scale.empty() || !file.torque_bias.empty() ||
                    !file.window.empty() || columns_by_position(file.columns))) {
     throw UsageError(
@@ -472,8 +481,8 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     run_experiment(o, options, file);
     return;
   }
-  const Model model =
-      load_cli_robot(o.robot, o.robot_flags, {"identify", o.runs, file.columns, {}, ""});
+  const Model model = load_cli_robot(o.robot, o.robot_flags,
+                                     {"identify", o.runs, file.columns, {}, "", file.topic});
   RunFileReport read;
   IdentificationResult result;
   RepeatedEstimate repeated;
@@ -629,9 +638,9 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
     }
   }
   const IdentifiedResultFile identified = read_identification_result(v.params);
-  const Model model =
-      load_cli_robot(v.robot, v.robot_flags,
-                     {"validate", {v.data}, file.columns, selection_stored_in(v.params), v.params});
+  const Model model = load_cli_robot(
+      v.robot, v.robot_flags,
+      {"validate", {v.data}, file.columns, selection_stored_in(v.params), v.params, file.topic});
   require_same_robot(identified.robot, model.name, "'" + v.params + "'",
                      "validate with the robot the parameters were identified on");
   std::vector<std::string> names = identified.names;
@@ -644,6 +653,7 @@ void run_validate(const ValidateCliOptions& v, const CLI::App& cmd) {
   overrides.columns_given = run_flag_given(cmd, "--columns");
   overrides.rate_given = run_flag_given(cmd, "--rate");
   overrides.torque_bias_given = run_flag_given(cmd, "--torque-bias");
+  overrides.topic_given = run_flag_given(cmd, "--topic");
   if (run_flag_given(cmd, "--time-shift")) overrides.time_shift = v.run.shift();
   const StoredIdentifyOptions stored =
       options_of_stored_result(identified, v.params, model.dof(), overrides);

@@ -143,6 +143,7 @@ void run_payload_from_result(const PayloadCliOptions& cli, const CLI::App& cmd,
   overrides.columns_given = run_flag_given(cmd, "--columns");
   overrides.rate_given = run_flag_given(cmd, "--rate");
   overrides.torque_bias_given = run_flag_given(cmd, "--torque-bias");
+  overrides.topic_given = run_flag_given(cmd, "--topic");
   if (run_flag_given(cmd, "--time-shift")) overrides.time_shift = cli.run.shift();
   const StoredIdentifyOptions stored =
       options_of_stored_result(identified, cli.reference, model.dof(), overrides);
@@ -189,9 +190,13 @@ void run_payload_from_torques(const PayloadCliOptions& cli, const CLI::App& cmd,
         "--sensor-link or --sensor-pose; use --frame to place the load's frame");
   }
   const RunFileOptions file = run_file_options(cli.run);
-  const Model model = load_cli_robot(
-      cli.robot, cli.robot_flags,
-      {"payload", {cli.data}, file.columns, selection_stored_in(cli.reference), cli.reference});
+  const Model model = load_cli_robot(cli.robot, cli.robot_flags,
+                                     {"payload",
+                                      {cli.data},
+                                      file.columns,
+                                      selection_stored_in(cli.reference),
+                                      cli.reference,
+                                      file.topic});
   LoadFrame frame;
   if (!cli.frame.empty()) {
     const auto pose =
@@ -322,8 +327,8 @@ void run_payload(const PayloadCliOptions& cli, const CLI::App& cmd) {
   SensorMotion motion;
   nlohmann::json frame;
   if (!cli.robot.empty()) {
-    const Model model =
-        load_cli_robot(cli.robot, cli.robot_flags, {"payload", {cli.data}, file.columns, {}, ""});
+    const Model model = load_cli_robot(cli.robot, cli.robot_flags,
+                                       {"payload", {cli.data}, file.columns, {}, "", file.topic});
     SensorMount mount;
     mount.link = find_link(model, cli.sensor_link);
     if (!cli.sensor_pose.empty()) {

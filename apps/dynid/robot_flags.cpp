@@ -9,6 +9,7 @@
 #include "dynid/common/message.hpp"
 #include "dynid/io/csv_chunk_reader.hpp"
 #include "dynid/io/joint_record_file.hpp"
+#include "dynid/io/joint_state_log.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/report/identification_report.hpp"
 #include "dynid/report/stored_result.hpp"
@@ -54,7 +55,12 @@ std::vector<std::string> joints_of_header(const Model& model, const RobotContext
   if (context.runs.empty() || columns_by_position(context.columns)) return {};
   std::vector<std::string> header;
   try {
-    header = CsvChunkReader(context.runs.front()).columns();
+    // A ROS log's names are in its messages: it is read once more here.
+    const std::string& run = context.runs.front();
+    const JointStateLogFormat format = joint_state_log_format(run);
+    header = format == JointStateLogFormat::kNone
+                 ? CsvChunkReader(run).columns()
+                 : read_joint_state_log(run, format, context.topic).table.columns;
   } catch (const Error&) {
     return {};
   }

@@ -37,10 +37,11 @@ void add_robot_flags(CLI::App* cmd, RobotFlags& flags,
 /// Where the joint selection may come from besides the flags.
 struct RobotContext {
   std::string command;            ///< prefix of the lines said on stderr ("identify")
-  std::vector<std::string> runs;  ///< CSV runs whose header may name the joints (q_<name>)
+  std::vector<std::string> runs;  ///< runs whose header (or ROS log) may name the joints
   ColumnMapping columns;          ///< --columns renames applied to those headers first
   JointSelection stored;          ///< the selection a result was identified with (stored_selection)
   std::string stored_from;        ///< that result's path, named in the note
+  std::string topic{};            ///< --topic of a run that is a ROS log (its names are read)
 };
 
 /// The robot `robot` (built-in name or path) loaded for a command: a non-physical inertia is a

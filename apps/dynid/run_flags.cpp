@@ -42,6 +42,10 @@ void add_run_flags(CLI::App* cmd, RunFlags& flags, RunFlagDefaults defaults) {
                   "(--friction ...,offset, the default): Fo<j> is that bias plus any other "
                   "constant torque" +
                       stored);
+  cmd->add_option("--topic", flags.topic,
+                  "sensor_msgs/JointState topic of a ROS log given as the run (.bag, .db3, "
+                  "PlotJuggler export); default /joint_states, or the log's only JointState topic" +
+                      stored);
 }
 
 RunFileOptions run_file_options(const RunFlags& flags) {
@@ -68,6 +72,7 @@ RunFileOptions run_file_options(const RunFlags& flags) {
   if (!flags.rows.empty()) file.window = parse_run_window(flags.rows, false, "--rows");
   if (!flags.time.empty()) file.window = parse_run_window(flags.time, true, "--time");
   file.torque_bias = parse_torque_bias(flags.torque_bias);
+  file.topic = flags.topic;
   return file;
 }
 

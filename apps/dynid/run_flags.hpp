@@ -26,6 +26,7 @@ struct RunFlags {
   /// CLI11's own errors, so run_file_options() checks it and names it.
   std::optional<std::string> old_time_shift;
   std::string torque_bias;  ///< --torque-bias J=VALUE,...; empty: no bias
+  std::string topic;        ///< --topic of a ROS log; empty: /joint_states or the only one
 
   /// The time shift [s] given by either name (checked by run_file_options()).
   double shift() const;
@@ -38,7 +39,7 @@ enum class RunFlagDefaults {
 };
 
 /// Registers --rate, --columns, --torque-scale, --rows, --time, --time-shift (and its hidden old
-/// name --torque-offset) and --torque-bias on `cmd`, bound to `flags`.
+/// name --torque-offset), --torque-bias and --topic on `cmd`, bound to `flags`.
 void add_run_flags(CLI::App* cmd, RunFlags& flags,
                    RunFlagDefaults defaults = RunFlagDefaults::kNone);
 

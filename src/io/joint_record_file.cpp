@@ -7,6 +7,7 @@
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
 #include "dynid/io/csv_reader.hpp"
+#include "dynid/io/joint_state_log.hpp"
 #include "dynid/model/transmission.hpp"
 #include "dynid/signal/differentiation.hpp"
 
@@ -240,7 +241,24 @@ RunTable read_run_table(const std::string& path, const RunFileOptions& options, 
   const bool positional = columns_by_position(options.columns);
   RunTable run;
   CsvTable& table = run.table;
-  table = positional ? read_csv_without_header(path) : read_csv(path);
+  const JointStateLogFormat format = joint_state_log_format(path);
+  if (format != JointStateLogFormat::kNone) {
+    if (positional) {
+      throw UsageError("--columns by position is for a CSV file without a header; '" + path +
+                       "' is a ROS log whose columns are named q_<joint>, dq_<joint>, "
+                       "tau_<joint>: rename by name (from=to) or drop --columns");
+    }
+    JointStateLog log = read_joint_state_log(path, format, options.topic);
+    table = std::move(log.table);
+    out.notes.insert(out.notes.end(), log.notes.begin(), log.notes.end());
+    out.warnings.insert(out.warnings.end(), log.warnings.begin(), log.warnings.end());
+  } else {
+    if (!options.topic.empty()) {
+      out.warnings.push_back("--topic " + printable(options.topic) + " has no effect: '" + path +
+                             "' is a CSV run, not a ROS log");
+    }
+    table = positional ? read_csv_without_header(path) : read_csv(path);
+  }
   apply_column_mapping(table, options.columns);
   out.notes.push_back("read " + std::to_string(table.rows()) + " rows of '" + path + "'" +
                       (positional ? " (no header: columns by position, counted from 1)" : ""));

@@ -129,6 +129,11 @@ StoredIdentifyOptions options_of_stored_result(const IdentifiedResultFile& ident
       if (!out.torque_bias.empty())
         out.notes.push_back("--torque-bias as given to identify (stored in '" + path + "')");
     }
+    if (!overrides.topic_given) {
+      out.topic = file.get("topic", std::string());
+      if (!out.topic.empty())
+        out.notes.push_back("--topic as given to identify (stored in '" + path + "')");
+    }
   } catch (const UsageError& e) {
     throw stored_option_error(e, path);
   }
@@ -149,6 +154,7 @@ void StoredIdentifyOptions::apply_to(RunFileOptions& file) const {
   }
   if (!torque_scale.empty()) file.torque_scale = torque_scale;
   if (!torque_bias.empty()) file.torque_bias = torque_bias;
+  if (!topic.empty()) file.topic = topic;
 }
 
 void add_stored_known_friction(const IdentifiedResultFile& identified, const std::string& path,

@@ -90,7 +90,7 @@ std::string help_line(const std::string& help, const std::string& flag) {
 TEST_F(RunFlagsCli, EveryCommandThatReadsARunTakesTheSameRunFlags) {
   const std::vector<std::string> commands = {"identify", "validate", "payload", "average"};
   const std::vector<std::string> flags = {"--rate", "--columns",    "--torque-scale", "--rows",
-                                          "--time", "--time-shift", "--torque-bias"};
+                                          "--time", "--time-shift", "--torque-bias",  "--topic"};
   const CliRun reference = run("identify --help");
   ASSERT_EQ(reference.code, 0);
   for (const std::string& command : commands) {

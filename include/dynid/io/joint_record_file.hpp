@@ -33,6 +33,9 @@ struct RunFileOptions {
   /// a joint number counted from 1 or a joint name, VALUE [N·m, or N for a prismatic joint] on the
   /// joint side, after the torque scale and the transmission. Joints not named keep 0.
   std::vector<std::pair<std::string, double>> torque_bias;
+  /// The ROS topic of sensor_msgs/JointState messages read from a ROS log (`--topic`; bags and
+  /// PlotJuggler exports name topics): empty = /joint_states, or the log's only JointState topic.
+  std::string topic;
   /// false when rate_hz is not the user's (a rate stored in a result): a t column that makes it
   /// useless is then a note, not a warning about a flag nobody gave.
   bool rate_given = true;
@@ -74,10 +77,14 @@ Eigen::VectorXd torque_bias_vector(const Model& model,
 void scale_torque_columns(RunTable& run, const RunFileOptions& options, RunFileReport& report);
 
 /// Reads `path` as a run with the options that need no model: options.columns, time from `t` or
-/// options.rate_hz, options.window. With `need_time` false a run without time information is read
-/// with an empty RunTable::t (a --time window then needs one). Throws as read_joint_record().
-/// Notes and warnings go to `report`. Commands that read other columns than a joint record's
-/// (payload's wrench, average's every column) read their run through this.
+/// options.rate_hz, options.window. A ROS log (joint_state_log_format(): `.bag`, `.db3`,
+/// `rostopic echo -p`, `ros2 topic echo --csv` or PlotJuggler CSV) is read by
+/// read_joint_state_log() from options.topic into the columns t, q_<name>, dq_<name>, tau_<name>
+/// first; --columns by position is then a dynid::UsageError (the log names its joints). With
+/// `need_time` false a run without time information is read with an empty RunTable::t (a --time
+/// window then needs one). Throws as read_joint_record(). Notes and warnings go to `report`.
+/// Commands that read other columns than a joint record's (payload's wrench, average's every
+/// column) read their run through this.
 RunTable read_run_table(const std::string& path, const RunFileOptions& options,
                         RunFileReport& report, bool need_time = true);
 

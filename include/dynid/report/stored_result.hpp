@@ -61,6 +61,7 @@ struct StoredOptionOverrides {
   bool columns_given = false;         ///< true: the caller's --columns, not the stored ones
   bool rate_given = false;            ///< true: the caller's --rate, not the stored one
   bool torque_bias_given = false;     ///< true: the caller's --torque-bias, not the stored one
+  bool topic_given = false;           ///< true: the caller's --topic, not the stored one
   std::optional<double> time_shift;   ///< [s]; unset: the time shift identify used
 };
 
@@ -79,10 +80,13 @@ struct StoredIdentifyOptions {
   double rate_hz = 0.0;  ///< options.rate_hz as given to identify (0 when none, or overridden)
   /// options.torque_bias as given to identify, parsed (empty when none, or overridden).
   std::vector<std::pair<std::string, double>> torque_bias;
+  /// options.topic as given to identify: the ROS topic its log was read from (empty when none,
+  /// or overridden).
+  std::string topic;
   std::vector<std::string> notes;  ///< one line per value taken from the file
 
-  /// Sets in `file` each of columns, rate, torque scale and bias that the result stores and the
-  /// caller did not override (a stored rate as not given: RunFileOptions::rate_given false).
+  /// Sets in `file` each of columns, rate, torque scale, bias and topic that the result stores and
+  /// the caller did not override (a stored rate as not given: RunFileOptions::rate_given false).
   void apply_to(RunFileOptions& file) const;
 };
 
