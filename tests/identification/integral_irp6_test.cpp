@@ -16,6 +16,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "dynid/estimation/least_squares.hpp"
 #include "dynid/estimation/statistics.hpp"
@@ -24,6 +25,7 @@
 #include "dynid/identification/integral_equations.hpp"
 #include "dynid/identification/validation.hpp"
 #include "dynid/model/robots.hpp"
+#include "dynid/report/identification_report.hpp"
 #include "identification/integral_support.hpp"
 
 namespace dynid {
@@ -304,6 +306,19 @@ TEST(IntegralIrp6Example, MotorTurningWithOneJointIsRegroupedIntoItsFriction) {
   EXPECT_TRUE(undetermined);
   EXPECT_LT(r.estimate.std_dev[i], 0.1 * 28.75) << r.estimate.x[i];
   EXPECT_NEAR(r.estimate.x[i], 28.75, 0.1 * 28.75);
+  for (size_t k = 0; k < r.names.size(); ++k)
+    if (r.labels[k] != r.names[k])
+      std::cout << "regrouped on these data: " << r.expressions[k] << "\n";
+  // The result file reports Fc2R and keeps the base name a later command looks up.
+  const nlohmann::json file =
+      identification_to_json(load_robot("irp6"), r, nlohmann::json::object());
+  const nlohmann::json& p = file["parameters"][static_cast<size_t>(i)];
+  EXPECT_EQ(p["name"], "Fc2R");
+  EXPECT_EQ(p["base_name"], "Fc2");
+  EXPECT_EQ(p["expression"], expression);
+  EXPECT_EQ(file["data_regrouped"].get<std::vector<std::string>>(), r.data_regrouped);
+  EXPECT_EQ(identification_result_from_json(file, "joint2.json").names, r.names);
+  EXPECT_NE(identification_table(load_robot("irp6"), r).find("Fc2R "), std::string::npos);
   // The union: joints 2 and 3 each move alone in one run, so Fcm3 = Fc2 + Fc3 on the union.
   const IdentificationResult& all = example_union().long_seed1;
   EXPECT_NE(std::find(all.not_excited.begin(), all.not_excited.end(), "Fcm3"),
