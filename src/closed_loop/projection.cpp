@@ -304,17 +304,19 @@ ProjectionResult project_on_reference(const JointRecord& run,
     check_orders(options.m1, options.m2, m, nm);
     win = fit(options.m1, options.m2, projector, coef);
   } else {
-    std::vector<int> orders;
-    for (int k : {2, 4, 8, 12, 16, 24, 32, 48, 64, 96, 128})
-      if (k <= options.max_order) orders.push_back(k);
-    for (int k = 192; k <= options.max_order; k = k * 3 / 2) orders.push_back(k);
-    if (orders.empty()) throw Error("projection max_order must be >= 2");
+    if (options.max_order < 2) throw Error("projection max_order must be >= 2");
+    // Past max_order only while the reference's dimensions are not all kept (the loop below
+    // stops at the run's length).
+    std::vector<int> orders = {2, 4, 8, 12, 16, 24, 32, 48, 64, 96, 128};
+    for (int k = 192; k <= std::max<Eigen::Index>(options.max_order, m / 2); k = k * 3 / 2)
+      orders.push_back(k);
     check_orders(orders.front(), orders.front(), m, nm);
     // The smallest order that keeps every dimension the reference spans (options.min_rank: a
     // shorter FIR drops lines of the excitation, and with them the information they carry) and
     // whose remainder no longer correlates with the reference.
     for (int k : orders) {
       if (m - 2 * k < 4 * (nm * (2 * k + 1) + 1)) break;  // the run is too short for this order
+      if (k > options.max_order && (!projector || projector->rank() >= options.min_rank)) break;
       win = fit(k, k, projector, coef);
       if (out.tests.back().passed && projector->rank() >= options.min_rank) break;
     }

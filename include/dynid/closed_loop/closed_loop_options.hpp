@@ -11,7 +11,9 @@ struct ProjectionOptions {
   int m1 = -1;  ///< non-causal lags (future reference samples, seed 2 eq. 10); −1 = choose
   int m2 =
       -1;  ///< causal lags (past reference samples); −1 = choose (m1, m2 both given or both −1)
-  int max_order = 128;         ///< largest M1 = M2 tried when choosing
+  /// Largest M1 = M2 tried when choosing, unless a larger one (as long as the run allows) is
+  /// needed to keep min_rank dimensions.
+  int max_order = 128;
   double significance = 0.01;  ///< family-wise level of the remainder–reference correlation test
   int test_lags = -1;  ///< largest |lag| tested; −1 = max(100, 3·max(M1, M2)), at most m/4
   double rank_tolerance = 1e-10;  ///< eigenvalues of the lagged-reference Gram below this × the

@@ -66,7 +66,8 @@ struct ProjectionResult {
 /// section 3's one-joint runs) is in the span of the constant c_j: the FIR's inputs are the moving
 /// references, and the held joints' q̂', q̂'' are zero (their motion is tracking error).
 /// Unless given, M1 = M2 = M is the smallest M of 2, 4, 8, 12, 16, 24, 32,
-/// 48, 64, 96, 128, … ≤ max_order whose projector keeps options.min_rank dimensions and whose
+/// 48, 64, 96, 128, … ≤ max_order (larger while min_rank is not reached and the run allows)
+/// whose projector keeps options.min_rank dimensions and whose
 /// torque remainder ũ passes the cross-correlation test
 /// of Ljung, "System Identification" (1999) §16.6: for every torque j, reference i and lag
 /// |τ| ≤ test_lags (inside and outside the window), z = √N·ρ̂_{ũr}(τ)/√P with
