@@ -522,12 +522,15 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
       for (size_t i = 0; i < o.runs.size(); ++i)
         references.push_back(read_reference_columns(o.runs[i], model, file, records[i]));
     }
+    // Every check the repeat can fail runs before the whole-run estimate (minutes on a long run).
+    RepeatedPieces pieces;
+    if (!o.repeat.empty()) {
+      pieces = repeated_pieces(records, references, options,
+                               o.repeat == "runs" ? RepeatOver::kRuns : RepeatOver::kPeriods);
+    }
     result =
         identify(model, records, closed ? references : std::vector<ReferenceRecord>{}, options);
-    if (!o.repeat.empty()) {
-      repeated = identify_repeated(model, records, references, options,
-                                   o.repeat == "runs" ? RepeatOver::kRuns : RepeatOver::kPeriods);
-    }
+    if (!o.repeat.empty()) repeated = identify_repeated(model, pieces, options);
     progress.finish();
     options.progress = nullptr;  // it refers to this scope's line
     for (size_t i = 0; i < result.runs.size(); ++i) result.runs[i].file = o.runs[i];

@@ -157,10 +157,62 @@ std::pair<double, double> band_energy(const Eigen::Ref<const Eigen::VectorXd>& x
   return {total, kept};
 }
 
-// held_joints_allowed: the spectral lines come from the moving joints' references, so a one-joint
-// run (seed 2 section 3: the other joints held) is fine; the projection's FIR needs every one.
-void check_reference(const JointRecord& run, const ReferenceRecord& reference,
-                     bool held_joints_allowed = false) {
+// A reference column that does not move (to 1e-12 of its level): a joint held by its controller.
+bool is_constant(const Eigen::Ref<const Eigen::VectorXd>& x) {
+  const double mean = x.mean();
+  return (x.array() - mean).abs().maxCoeff() <= 1e-12 * std::max(1.0, std::abs(mean));
+}
+
+// The reference's exact period [samples]: detected from qr (at least two periods in the run), or
+// the whole run when the given dqr is the Fourier derivative of qr taken as one period (one period
+// alone cannot show that it repeats; its derivative can). 0 when neither holds.
+int reference_period(const ReferenceRecord& reference, double ts) {
+  const int p = exact_period(reference.qr);
+  const Eigen::Index m = reference.qr.rows();
+  if (p > 0 || reference.dqr.size() == 0 || m <= 2) return p;
+  const Eigen::MatrixXd d = periodic_derivative(reference.qr, static_cast<int>(m), ts, 1);
+  return (d - reference.dqr).cwiseAbs().maxCoeff() <=
+                 1e-6 * std::max(reference.dqr.cwiseAbs().maxCoeff(), 1e-300)
+             ? static_cast<int>(m)
+             : 0;
+}
+
+// The lines of a p-periodic reference over the run's last whole periods (seed 2 section 3.4).
+struct ReferenceLines {
+  Eigen::MatrixXd amplitude;  // (p − 1)/2 + 1 harmonics × joints: each line's amplitude
+  std::vector<int> lines;     // harmonics above line_fraction × the same joint's largest
+};
+
+ReferenceLines reference_lines(const Eigen::MatrixXd& qr, int p, double line_fraction) {
+  if (!(line_fraction > 0.0 && line_fraction < 1.0))
+    throw Error("spectral line_fraction must be in (0, 1), got " + num(line_fraction));
+  const Eigen::Index m = qr.rows(), n = qr.cols();
+  const int periods = static_cast<int>(m / p);
+  const Eigen::Index len = static_cast<Eigen::Index>(periods) * p, first = m - len;
+  Eigen::FFT<double> fft;
+  const int top = (p - 1) / 2;  // highest harmonic below Nyquist
+  ReferenceLines out;
+  out.amplitude = Eigen::MatrixXd::Zero(top + 1, n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    // A held joint has no lines: the round-off of a constant away from 0 would make every
+    // harmonic one (relative to its own largest), and the band the whole spectrum.
+    if (is_constant(qr.col(j))) continue;
+    Eigen::VectorXd a = Eigen::VectorXd::Zero(top + 1);
+    band_energy(qr.col(j).segment(first, len), periods, top, fft, &a);
+    out.amplitude.col(j) = a;
+  }
+  for (int h = 1; h <= top; ++h) {
+    bool line = false;
+    for (Eigen::Index j = 0; j < n; ++j)
+      line = line || out.amplitude(h, j) > line_fraction * out.amplitude.col(j).maxCoeff();
+    if (line) out.lines.push_back(h);
+  }
+  return out;
+}
+
+// A joint whose reference is constant is held by its controller (seed 2 section 3: one joint
+// moves at a time); both preparations take it as still. Only a run where nothing moves is refused.
+void check_reference(const JointRecord& run, const ReferenceRecord& reference) {
   const Eigen::Index m = run.t.size(), n = run.q.cols();
   if (reference.qr.size() == 0)
     throw Error("closed-loop identification needs the reference columns qr1..qr" +
@@ -179,32 +231,35 @@ void check_reference(const JointRecord& run, const ReferenceRecord& reference,
   check(reference.dqr, "dqr", true);
   check(reference.ddqr, "ddqr", true);
   Eigen::Index moving = 0;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const double mean = reference.qr.col(i).mean();
-    const bool constant = (reference.qr.col(i).array() - mean).abs().maxCoeff() <=
-                          1e-12 * std::max(1.0, std::abs(mean));
-    if (constant && !held_joints_allowed)
-      throw Error("reference qr" + std::to_string(i + 1) + " is constant (" + num(mean) +
-                  "): it drives nothing the projection can use; excite every joint");
-    moving += constant ? 0 : 1;
-  }
+  for (Eigen::Index i = 0; i < n; ++i) moving += !is_constant(reference.qr.col(i));
   if (moving == 0)
     throw Error("every reference qr1..qr" + std::to_string(n) +
                 " is constant: the run excites nothing; move at least one joint");
+}
+
+// The processing choice that names the joints a one-joint run holds (0-based in, 1-based out).
+void note_held_joints(const std::vector<int>& held,
+                      std::vector<std::pair<std::string, std::string>>& choices) {
+  if (held.empty()) return;
+  std::string list;
+  for (int j : held) list += (list.empty() ? "" : ", ") + std::to_string(j + 1);
+  choices.emplace_back(
+      "still_joints",
+      "joints " + list + " (constant reference): held, velocity and acceleration taken as zero");
 }
 
 ClosedLoopRun prepare_projection(const JointRecord& run, const ReferenceRecord& reference,
                                  const ClosedLoopIdOptions& options, double ts,
                                  std::vector<std::pair<std::string, std::string>>& choices) {
   Eigen::MatrixXd dqr = reference.dqr, ddqr = reference.ddqr;
+  const int period = reference_period(reference, ts);
   if (dqr.size() == 0 || ddqr.size() == 0) {
-    const int p = exact_period(reference.qr);
-    if (p > 0) {
-      if (dqr.size() == 0) dqr = periodic_derivative(reference.qr, p, ts, 1);
-      if (ddqr.size() == 0) ddqr = periodic_derivative(reference.qr, p, ts, 2);
+    if (period > 0) {
+      if (dqr.size() == 0) dqr = periodic_derivative(reference.qr, period, ts, 1);
+      if (ddqr.size() == 0) ddqr = periodic_derivative(reference.qr, period, ts, 2);
       choices.emplace_back("reference_derivatives",
                            "from the periodic reference's Fourier series (period " +
-                               std::to_string(p) + " samples)");
+                               std::to_string(period) + " samples)");
     } else {
       if (dqr.size() == 0) dqr = central_difference(run.t, reference.qr, 1);
       if (ddqr.size() == 0) ddqr = central_difference(run.t, dqr, 1);
@@ -215,11 +270,24 @@ ClosedLoopRun prepare_projection(const JointRecord& run, const ReferenceRecord& 
   } else {
     choices.emplace_back("reference_derivatives", "dqr*, ddqr* from the data");
   }
-  ProjectionResult p = project_on_reference(run, reference.qr, dqr, ddqr, options.projection);
+  // A periodic reference with L lines spans 2L + 1 dimensions (cos and sin of each line, and the
+  // constant) at every lag: an automatic FIR order that kept fewer would drop lines of the
+  // excitation (a 4-harmonic reference at 100 Hz: M = 2 kept 7 of 9).
+  ProjectionOptions po = options.projection;
+  int dimensions = 0;
+  if (period > 0) {
+    dimensions =
+        2 * static_cast<int>(
+                reference_lines(reference.qr, period, options.line_fraction).lines.size()) +
+        1;
+    if (po.min_rank == 0) po.min_rank = dimensions;
+  }
+  ProjectionResult p = project_on_reference(run, reference.qr, dqr, ddqr, po);
   ClosedLoopRun out;
   out.processed = std::move(p.processed);
   out.projector = p.projector;
   out.torque_remainder_std = p.torque_remainder_std;
+  out.warnings = p.warnings;
   ClosedLoopReport& rep = out.report;
   rep.method = ClosedLoopMethod::kProjection;
   rep.rank = p.projector->rank();
@@ -229,13 +297,19 @@ ClosedLoopRun prepare_projection(const JointRecord& run, const ReferenceRecord& 
   rep.max_z = p.tests.back().max_z;
   rep.threshold = p.tests.back().threshold;
   rep.test_passed = p.tests.back().passed;
+  rep.reference_dimensions = dimensions;
+  rep.held_joints = p.held_joints;
+  note_held_joints(p.held_joints, choices);
   std::ostringstream s;
   s << std::setprecision(3) << "projection on the lagged references (Forssell-Ljung; seed 2 "
     << "eqs. 10-12): M1 = " << p.m1 << ", M2 = " << p.m2
-    << (options.projection.m1 >= 0 ? " (given)" : " (smallest passing the test)")
+    << (options.projection.m1 >= 0 ? " (given)"
+                                   : " (smallest passing the test and keeping the reference's "
+                                     "dimensions)")
     << "; remainder-reference test max |z| " << rep.max_z << " vs bound " << rep.threshold
     << (rep.test_passed ? " (passed)" : " (FAILED)") << "; the regressor columns projected alike; "
     << p.projector->rank() << " dimensions per channel (interval degrees of freedom)";
+  if (dimensions > 0) s << " of the " << dimensions << " the periodic reference spans";
   choices.emplace_back("closed_loop", s.str());
   return out;
 }
@@ -279,42 +353,20 @@ ClosedLoopRun prepare_spectral(const JointRecord& run, const ReferenceRecord& re
                                const ClosedLoopIdOptions& options, double ts,
                                std::vector<std::pair<std::string, std::string>>& choices) {
   const Eigen::Index m = run.t.size(), n = run.q.cols();
-  int p = options.period > 0.0 ? given_period(reference.qr, options, ts, choices)
-                               : exact_period(reference.qr);
-  if (p == 0 && reference.dqr.size() != 0 && m > 2) {
-    // One period alone cannot show that it repeats; a given derivative can: it equals the Fourier
-    // derivative of qr taken as one period exactly when qr is one period of a periodic signal.
-    const Eigen::MatrixXd d = periodic_derivative(reference.qr, static_cast<int>(m), ts, 1);
-    if ((d - reference.dqr).cwiseAbs().maxCoeff() <=
-        1e-6 * std::max(reference.dqr.cwiseAbs().maxCoeff(), 1e-300))
-      p = static_cast<int>(m);
-  }
+  const int p = options.period > 0.0 ? given_period(reference.qr, options, ts, choices)
+                                     : reference_period(reference, ts);
   if (p == 0)
     throw Error(
         "--closed-loop spectral needs a periodic reference sampled a whole number of times per "
         "period, with at least two periods: qr does not repeat; use --closed-loop projection");
   const int periods = static_cast<int>(m / p);
   const Eigen::Index len = static_cast<Eigen::Index>(periods) * p, first = m - len;
-  if (!(options.line_fraction > 0.0 && options.line_fraction < 1.0))
-    throw Error("spectral line_fraction must be in (0, 1), got " + num(options.line_fraction));
   ExcitationSpectrum sp;
   sp.period_samples = p;
   sp.periods = periods;
   sp.f0_hz = 1.0 / (p * ts);
+  sp.lines = reference_lines(reference.qr, p, options.line_fraction).lines;
   Eigen::FFT<double> fft;
-  const int top = (p - 1) / 2;  // highest harmonic below Nyquist
-  Eigen::MatrixXd amplitude = Eigen::MatrixXd::Zero(top + 1, n);
-  for (Eigen::Index j = 0; j < n; ++j) {
-    Eigen::VectorXd a = Eigen::VectorXd::Zero(top + 1);
-    band_energy(reference.qr.col(j).segment(first, len), periods, top, fft, &a);
-    amplitude.col(j) = a;
-  }
-  for (int h = 1; h <= top; ++h) {
-    bool line = false;
-    for (Eigen::Index j = 0; j < n; ++j)
-      line = line || amplitude(h, j) > options.line_fraction * amplitude.col(j).maxCoeff();
-    if (line) sp.lines.push_back(h);
-  }
   sp.band_harmonic = sp.lines.empty() ? 1 : sp.lines.back();
   sp.reference_energy_above_band.resize(n);
   sp.torque_energy_removed.resize(n);
@@ -339,17 +391,15 @@ ClosedLoopRun prepare_spectral(const JointRecord& run, const ReferenceRecord& re
   // A joint whose reference is constant was held by the controller (one-joint runs, seed 2
   // section 3): its projected motion is tracking error, not excitation, and would make its
   // velocity columns (Ia, friction) look excited; taken as still, as identify's still joints.
-  std::string held;
+  std::vector<int> held;
   for (Eigen::Index j = 0; j < n; ++j) {
-    if (amplitude.col(j).maxCoeff() > 0.0) continue;
+    if (!is_constant(reference.qr.col(j))) continue;
     r.dq.col(j).setZero();
     r.ddq.col(j).setZero();
-    held += (held.empty() ? "" : ", ") + std::to_string(j + 1);
+    held.push_back(static_cast<int>(j));
   }
-  if (!held.empty())
-    choices.emplace_back("still_joints", "joints " + held +
-                                             " (constant reference): held, velocity and "
-                                             "acceleration taken as zero");
+  note_held_joints(held, choices);
+  out.report.held_joints = held;
   out.processed.rate_hz = 1.0 / ts;
   out.processed.position_noise_std =
       ((q - r.q).colwise().squaredNorm() / static_cast<double>(len)).cwiseSqrt().transpose();
@@ -384,7 +434,7 @@ ClosedLoopRun prepare_closed_loop(const JointRecord& input, const ReferenceRecor
                                   std::vector<std::pair<std::string, std::string>>& choices) {
   if (options.method == ClosedLoopMethod::kNone)
     throw Error("prepare_closed_loop: no closed-loop method chosen");
-  check_reference(input, reference, options.method == ClosedLoopMethod::kSpectral);
+  check_reference(input, reference);
   const SamplingInfo info =
       require_uniform_sampling(input.t, 1e-6, "closed-loop identification (the reference's lags)");
   const double ts = info.mean_period;
@@ -636,14 +686,18 @@ RepeatedEstimate repeated_statistics(
   return out;
 }
 
-RepeatedEstimate identify_repeated(const Model& model, const std::vector<JointRecord>& runs,
-                                   const std::vector<ReferenceRecord>& references,
-                                   const IdentifyOptions& options, RepeatOver over) {
-  std::vector<JointRecord> pieces;
-  std::vector<ReferenceRecord> piece_references;
+RepeatedPieces repeated_pieces(const std::vector<JointRecord>& runs,
+                               const std::vector<ReferenceRecord>& references,
+                               const IdentifyOptions& options, RepeatOver over) {
+  const bool closed = options.closed_loop.method != ClosedLoopMethod::kNone;
+  RepeatedPieces out;
   if (over == RepeatOver::kRuns) {
-    pieces = runs;
-    piece_references = references;
+    if (closed) {
+      check_closed_loop_request(options, runs.size(), references.size());
+      for (size_t i = 0; i < runs.size(); ++i) check_reference(runs[i], references[i]);
+      out.references = references;
+    }
+    out.runs = runs;
   } else {
     const bool missing = std::any_of(references.begin(), references.end(),
                                      [](const ReferenceRecord& r) { return r.qr.size() == 0; });
@@ -660,7 +714,7 @@ RepeatedEstimate identify_repeated(const Model& model, const std::vector<JointRe
             "the run: qr does not repeat (run " +
             std::to_string(i + 1) + ")");
       // Derivatives of the whole periodic reference: one period alone cannot show it repeats (the
-      // spectral preparation checks a period against them).
+      // preparations check a period against them, reference_period).
       ReferenceRecord ref = references[i];
       const double ts = (runs[i].t[runs[i].t.size() - 1] - runs[i].t[0]) /
                         static_cast<double>(runs[i].t.size() - 1);
@@ -671,26 +725,40 @@ RepeatedEstimate identify_repeated(const Model& model, const std::vector<JointRe
         auto rows = [&](const Eigen::MatrixXd& x) {
           return x.size() ? Eigen::MatrixXd(x.middleRows(first, p)) : Eigen::MatrixXd();
         };
-        pieces.push_back({r.t.segment(first, p), rows(r.q), rows(r.dq), rows(r.ddq), rows(r.tau)});
-        piece_references.push_back({rows(ref.qr), rows(ref.dqr), rows(ref.ddqr)});
+        out.runs.push_back(
+            {r.t.segment(first, p), rows(r.q), rows(r.dq), rows(r.ddq), rows(r.tau)});
+        if (closed) out.references.push_back({rows(ref.qr), rows(ref.dqr), rows(ref.ddqr)});
       }
     }
   }
-  if (pieces.size() < 2)
+  if (out.runs.size() < 2)
     throw Error("--repeat needs at least 2 " +
                 std::string(over == RepeatOver::kRuns ? "runs (give --data several times)"
                                                       : "whole periods in the run") +
-                ", got " + std::to_string(pieces.size()));
+                ", got " + std::to_string(out.runs.size()));
+  return out;
+}
+
+RepeatedEstimate identify_repeated(const Model& model, const RepeatedPieces& pieces,
+                                   const IdentifyOptions& options) {
+  const bool closed = options.closed_loop.method != ClosedLoopMethod::kNone;
+  check_closed_loop_request(options, pieces.runs.size(),
+                            closed ? pieces.references.size() : pieces.runs.size());
   std::vector<std::pair<std::vector<std::string>, Eigen::VectorXd>> estimates;
-  for (size_t i = 0; i < pieces.size(); ++i) {
+  for (size_t i = 0; i < pieces.runs.size(); ++i) {
     const std::vector<ReferenceRecord> ref =
-        options.closed_loop.method == ClosedLoopMethod::kNone
-            ? std::vector<ReferenceRecord>{}
-            : std::vector<ReferenceRecord>{piece_references.at(i)};
-    const IdentificationResult r = identify(model, {pieces[i]}, ref, options);
+        closed ? std::vector<ReferenceRecord>{pieces.references[i]}
+               : std::vector<ReferenceRecord>{};
+    const IdentificationResult r = identify(model, {pieces.runs[i]}, ref, options);
     estimates.emplace_back(r.names, r.estimate.x);
   }
   return repeated_statistics(estimates, options.confidence_level);
+}
+
+RepeatedEstimate identify_repeated(const Model& model, const std::vector<JointRecord>& runs,
+                                   const std::vector<ReferenceRecord>& references,
+                                   const IdentifyOptions& options, RepeatOver over) {
+  return identify_repeated(model, repeated_pieces(runs, references, options, over), options);
 }
 
 }  // namespace dynid

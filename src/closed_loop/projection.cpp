@@ -181,24 +181,24 @@ Spectrum spectrum(const Eigen::Ref<const Eigen::VectorXd>& x, int nfft, Eigen::F
 // Ljung (1999) §16.6 cross-correlation test of the torque remainder against every reference.
 ProjectionTest remainder_test(const Eigen::MatrixXd& remainder, const Eigen::MatrixXd& r,
                               const Window& win, int lags, double significance) {
-  const Eigen::Index n = r.cols(), len = win.len;
+  const Eigen::Index nu = remainder.cols(), nr = r.cols(), len = win.len;
   int nfft = 1;
   while (nfft < 2 * len) nfft *= 2;
   Eigen::FFT<double> fft;
   std::vector<Spectrum> su, sr;
-  for (Eigen::Index j = 0; j < n; ++j) su.push_back(spectrum(remainder.col(j), nfft, fft));
-  for (Eigen::Index i = 0; i < n; ++i)
+  for (Eigen::Index j = 0; j < nu; ++j) su.push_back(spectrum(remainder.col(j), nfft, fft));
+  for (Eigen::Index i = 0; i < nr; ++i)
     sr.push_back(spectrum(r.col(i).segment(win.t0, len), nfft, fft));
   ProjectionTest test;
   test.m1 = win.m1;
   test.m2 = win.m2;
-  const double count = static_cast<double>(n * n * (2 * lags + 1));
+  const double count = static_cast<double>(nu * nr * (2 * lags + 1));
   test.threshold = boost::math::quantile(
       boost::math::complement(boost::math::normal(), significance / (2.0 * count)));
-  for (Eigen::Index j = 0; j < n; ++j) {
+  for (Eigen::Index j = 0; j < nu; ++j) {
     if (!(su[j].norm > 0.0)) continue;  // an exact fit has nothing left to correlate
     const Eigen::VectorXd ru = correlation(su[j].f, su[j].f, su[j].norm * su[j].norm, lags, fft);
-    for (Eigen::Index i = 0; i < n; ++i) {
+    for (Eigen::Index i = 0; i < nr; ++i) {
       const Eigen::VectorXd rr = correlation(sr[i].f, sr[i].f, sr[i].norm * sr[i].norm, lags, fft);
       const double p = std::max(ru.dot(rr), 1.0 / static_cast<double>(len));
       const Eigen::VectorXd cross =
@@ -246,64 +246,112 @@ ProjectionResult project_on_reference(const JointRecord& run,
   check(dqr, "dqr");
   check(ddqr, "ddqr");
   const SamplingInfo info = require_uniform_sampling(run.t, 1e-6, "the projection method");
+  // A constant reference (a joint its controller holds: seed 2 section 3 moves one joint at a
+  // time) lies in the span of the FIR's constant term at every lag: it adds no dimension, so the
+  // FIR is fitted on the moving references alone, and the held joints' derivatives are taken as
+  // zero below.
+  std::vector<Eigen::Index> moving;
+  std::vector<int> held;
   for (Eigen::Index i = 0; i < n; ++i) {
     const double mean = qr.col(i).mean();
     if ((qr.col(i).array() - mean).abs().maxCoeff() <= 1e-12 * std::max(1.0, std::abs(mean)))
-      throw Error("reference qr" + std::to_string(i + 1) + " is constant (" + short_number(mean) +
-                  "): it drives nothing the projection can use; excite every joint");
+      held.push_back(static_cast<int>(i));
+    else
+      moving.push_back(i);
   }
+  if (moving.empty())
+    throw Error("every reference qr1..qr" + std::to_string(n) +
+                " is constant: the run excites nothing; move at least one joint");
+  const auto nm = static_cast<Eigen::Index>(moving.size());
   if ((options.m1 < 0) != (options.m2 < 0) || options.m1 < -1 || options.m2 < -1)
     throw Error("FIR orders must be both given (M1, M2 >= 0) or both chosen (-1), got M1 = " +
                 std::to_string(options.m1) + ", M2 = " + std::to_string(options.m2));
   if (!(options.significance > 0.0 && options.significance < 1.0))
     throw Error("projection significance must be in (0, 1), got " +
                 short_number(options.significance));
+  if (options.min_rank < 0)
+    throw Error("projection min_rank must be >= 0, got " + std::to_string(options.min_rank));
 
-  Eigen::MatrixXd r = qr, u(m, 2 * n);
+  Eigen::MatrixXd r(m, nm), dr(m, nm), ddr(m, nm), u(m, 2 * n);
+  for (Eigen::Index c = 0; c < nm; ++c) {
+    r.col(c) = qr.col(moving[static_cast<size_t>(c)]);
+    dr.col(c) = dqr.col(moving[static_cast<size_t>(c)]);
+    ddr.col(c) = ddqr.col(moving[static_cast<size_t>(c)]);
+  }
   u << run.tau, run.q;
   ProjectionResult out;
+  out.held_joints = held;
   auto lags_for = [&](const Window& win) {
     const int wanted =
         options.test_lags > 0 ? options.test_lags : std::max(100, 3 * std::max(win.m1, win.m2));
     return static_cast<int>(std::max<Eigen::Index>(1, std::min<Eigen::Index>(wanted, win.len / 4)));
   };
+  // One FIR order: the projector, the coefficients of every output and the remainder's test.
+  auto fit = [&](int m1, int m2, std::shared_ptr<FirProjector>& projector, Eigen::MatrixXd& coef) {
+    const Window w = window_for(m1, m2, m);
+    projector = std::make_shared<FirProjector>(r, w, options.rank_tolerance);
+    coef = projector->coefficients(u);
+    Eigen::MatrixXd rem(w.len, n);
+    for (Eigen::Index j = 0; j < n; ++j)
+      rem.col(j) = u.col(j).segment(w.t0, w.len) - apply_fir(r, coef.col(j), w, true);
+    out.tests.push_back(remainder_test(rem, r, w, lags_for(w), options.significance));
+    return w;
+  };
   Eigen::MatrixXd coef;
   Window win{};
   std::shared_ptr<FirProjector> projector;
   if (options.m1 >= 0) {
-    check_orders(options.m1, options.m2, m, n);
-    win = window_for(options.m1, options.m2, m);
-    projector = std::make_shared<FirProjector>(r, win, options.rank_tolerance);
-    coef = projector->coefficients(u);
-    Eigen::MatrixXd rem(win.len, n);
-    for (Eigen::Index j = 0; j < n; ++j)
-      rem.col(j) = u.col(j).segment(win.t0, win.len) - apply_fir(r, coef.col(j), win, true);
-    out.tests.push_back(remainder_test(rem, r, win, lags_for(win), options.significance));
+    check_orders(options.m1, options.m2, m, nm);
+    win = fit(options.m1, options.m2, projector, coef);
   } else {
-    std::vector<int> orders;
-    for (int k : {2, 4, 8, 12, 16, 24, 32, 48, 64, 96, 128})
-      if (k <= options.max_order) orders.push_back(k);
-    for (int k = 192; k <= options.max_order; k = k * 3 / 2) orders.push_back(k);
-    if (orders.empty()) throw Error("projection max_order must be >= 2");
-    check_orders(orders.front(), orders.front(), m, n);
+    if (options.max_order < 2) throw Error("projection max_order must be >= 2");
+    // Past max_order only while the reference's dimensions are not all kept (the loop below
+    // stops at the run's length).
+    std::vector<int> orders = {2, 4, 8, 12, 16, 24, 32, 48, 64, 96, 128};
+    for (int k = 192; k <= std::max<Eigen::Index>(options.max_order, m / 2); k = k * 3 / 2)
+      orders.push_back(k);
+    check_orders(orders.front(), orders.front(), m, nm);
+    // The smallest order that keeps every dimension the reference spans (options.min_rank: a
+    // shorter FIR drops lines of the excitation, and with them the information they carry) and
+    // whose remainder no longer correlates with the reference.
     for (int k : orders) {
-      if (m - 2 * k < 4 * (n * (2 * k + 1) + 1)) break;  // the run is too short for this order
-      const Window w = window_for(k, k, m);
-      auto candidate = std::make_shared<FirProjector>(r, w, options.rank_tolerance);
-      Eigen::MatrixXd c = candidate->coefficients(u);
-      Eigen::MatrixXd rem(w.len, n);
-      for (Eigen::Index j = 0; j < n; ++j)
-        rem.col(j) = u.col(j).segment(w.t0, w.len) - apply_fir(r, c.col(j), w, true);
-      out.tests.push_back(remainder_test(rem, r, w, lags_for(w), options.significance));
-      win = w;
-      coef = std::move(c);
-      projector = std::move(candidate);
-      if (out.tests.back().passed) break;
+      if (m - 2 * k < 4 * (nm * (2 * k + 1) + 1)) break;  // the run is too short for this order
+      if (k > options.max_order && (!projector || projector->rank() >= options.min_rank)) break;
+      win = fit(k, k, projector, coef);
+      if (out.tests.back().passed && projector->rank() >= options.min_rank) break;
+    }
+    if (projector->rank() < options.min_rank) {
+      out.warnings.push_back(
+          "the projection's FIR keeps " + std::to_string(projector->rank()) + " of the " +
+          std::to_string(options.min_rank) +
+          " dimensions the reference spans (M1 = M2 = " + std::to_string(win.m1) +
+          ", the largest tried): the dropped lines carry no information into "
+          "the estimate; record a longer run or use --closed-loop spectral");
     }
   }
+  const ProjectionTest& test = out.tests.back();
+  if (!test.passed) {
+    out.warnings.push_back(
+        "the torque remainder of the projection still correlates with the reference (max |z| " +
+        short_number(test.max_z) + " > " + short_number(test.threshold) +
+        " at M1 = " + std::to_string(win.m1) + ", M2 = " + std::to_string(win.m2) +
+        (options.m1 >= 0 ? ", given" : ", the largest tried") +
+        "): the FIR misses part of the loop's response to the reference, and the projected "
+        "torques with it; " +
+        (options.m1 >= 0 ? "give larger orders with --fir or leave them to the automatic choice"
+                         : "record a longer run"));
+  }
+  // The coefficients in the documented layout: one block of rows per reference, zero for the
+  // held ones.
+  const Eigen::Index width = win.w;
+  Eigen::MatrixXd fir = Eigen::MatrixXd::Zero(n * width + 1, 2 * n);
+  for (Eigen::Index c = 0; c < nm; ++c)
+    fir.middleRows(moving[static_cast<size_t>(c)] * width, width) =
+        coef.middleRows(c * width, width);
+  fir.row(n * width) = coef.row(nm * width);
   out.m1 = win.m1;
   out.m2 = win.m2;
-  out.fir = coef;
+  out.fir = std::move(fir);
   out.projector = projector;
 
   JointRecord& rec = out.processed.record;
@@ -319,8 +367,8 @@ ProjectionResult project_on_reference(const JointRecord& run,
   for (Eigen::Index j = 0; j < n; ++j) {
     rec.tau.col(j) = apply_fir(r, coef.col(j), win, true);
     rec.q.col(j) = apply_fir(r, coef.col(n + j), win, true);
-    rec.dq.col(j) = apply_fir(dqr, coef.col(n + j), win, false);
-    rec.ddq.col(j) = apply_fir(ddqr, coef.col(n + j), win, false);
+    rec.dq.col(j) = apply_fir(dr, coef.col(n + j), win, false);
+    rec.ddq.col(j) = apply_fir(ddr, coef.col(n + j), win, false);
     const Eigen::VectorXd ut = u.col(j).segment(win.t0, win.len) - rec.tau.col(j);
     const Eigen::VectorXd qt = u.col(n + j).segment(win.t0, win.len) - rec.q.col(j);
     const Eigen::VectorXd uc = rec.tau.col(j).array() - rec.tau.col(j).mean();
@@ -329,6 +377,13 @@ ProjectionResult project_on_reference(const JointRecord& run,
     out.torque_remainder_std[j] = std::sqrt(ut.squaredNorm() / static_cast<double>(win.len));
     out.processed.position_noise_std[j] =
         std::sqrt(qt.squaredNorm() / static_cast<double>(win.len));
+  }
+  // A held joint's projected motion is its tracking error's response to the moving references,
+  // not excitation: taken as still (as the spectral preparation and identify's still joints do),
+  // so that its armature and friction columns do not look excited.
+  for (int j : held) {
+    rec.dq.col(j).setZero();
+    rec.ddq.col(j).setZero();
   }
   out.processed.rate_hz = info.rate_hz();
   return out;

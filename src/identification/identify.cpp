@@ -37,7 +37,9 @@ int column_joint(const Model& model, const ParameterLayout& layout, int column) 
 // it where that is cheap to say (its own joint, or the parameters it cannot be told from).
 void not_excited_warnings(const Model& model, const ParameterLayout& layout,
                           const BaseParameters& base, const EquationBlock& based,
-                          const DataIdentifiability& data, std::vector<std::string>& warnings) {
+                          const DataIdentifiability& data,
+                          const std::vector<std::string>& expressions,
+                          std::vector<std::string>& warnings) {
   std::ostringstream head;
   head << std::setprecision(3) << "the data excite " << data.rank << " of the model's " << base.rank
        << " base parameters (data rank): the others are not estimated (not_excited)";
@@ -56,9 +58,20 @@ void not_excited_warnings(const Model& model, const ParameterLayout& layout,
     const std::string& name = base.names[static_cast<size_t>(c)];
     const int joint = column_joint(model, layout, base.base[static_cast<size_t>(c)]);
     std::ostringstream w;
-    w << name << " is not excited: ";
-    if (based.W.col(c).squaredNorm() == 0.0) {
-      w << "its column is zero on every equation used";
+    const bool regrouped =
+        std::find(data.regrouped.begin(), data.regrouped.end(), c) != data.regrouped.end();
+    if (regrouped) {
+      // Exactly dependent: one parameter with those that absorb it, not a question of noise.
+      std::string into;
+      for (size_t i = 0; i < data.kept.size(); ++i) {
+        for (const auto& [col, coef] : data.absorbs[i]) {
+          if (col == c) into += (into.empty() ? "" : "; ") + expressions[i];
+        }
+      }
+      w << name << " is regrouped on these data: its column is a combination of the estimated "
+        << "ones to round-off, so it is estimated only with them (" << into << ")";
+    } else if (based.W.col(c).squaredNorm() == 0.0) {
+      w << name << " is not excited: its column is zero on every equation used";
     } else {
       std::string with;
       for (size_t i = 0; i < data.kept.size(); ++i) {
@@ -67,13 +80,15 @@ void not_excited_warnings(const Model& model, const ParameterLayout& layout,
             with += (with.empty() ? "" : ", ") + base.names[static_cast<size_t>(data.kept[i])];
         }
       }
-      w << "the data cannot tell it from " << (with.empty() ? "the other parameters" : with)
+      w << name << " is not excited: the data cannot tell it from "
+        << (with.empty() ? "the other parameters" : with)
         << " (those estimates include its effect on these runs)";
     }
     if (joint >= 0) {
       w << "; a run in which " << model.joints[static_cast<size_t>(joint)].name
         << " moves (above its encoder noise, with both velocity signs and varied "
-           "configurations of the joints before it) would excite it";
+           "configurations of the joints before it) would "
+        << (regrouped ? "separate it" : "excite it");
     }
     warnings.push_back(w.str());
   }
@@ -163,6 +178,8 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
       ClosedLoopIdOptions co = options.closed_loop;
       co.torque_time_offset = options.signal.torque_time_offset;
       ClosedLoopRun cl = prepare_closed_loop(screened.back().record, references[i], co, choices);
+      const std::string run_name = runs.size() > 1 ? "run " + std::to_string(i + 1) + ": " : "";
+      for (const std::string& w : cl.warnings) result.warnings.push_back(run_name + w);
       processed = std::move(cl.processed);
       // Known friction (seed 2 section 3.4) leaves the torque before the projection, so that
       // both sides of the regression are projected alike.
@@ -252,10 +269,24 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
   for (int c : data.not_excited) {
     result.not_excited.push_back(result.base.names[static_cast<size_t>(c)]);
   }
+  for (int c : data.regrouped)
+    result.data_regrouped.push_back(result.base.names[static_cast<size_t>(c)]);
+  result.labels = result.names;
   result.data_regrouping =
       Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(data.kept.size()),
                             static_cast<Eigen::Index>(data.not_excited.size()));
   for (size_t i = 0; i < data.kept.size(); ++i) {
+    // A parameter these data regroup exactly is named as the base set names a regrouping: the
+    // leading name with an R (issue 28 item 7: Fc2R = Fc2 + Fcm3 on an IRp-6 joint-2 run).
+    std::string& label = result.labels[i];
+    for (const auto& [col, coef] : data.absorbs[i]) {
+      const bool exact =
+          std::find(data.regrouped.begin(), data.regrouped.end(), col) != data.regrouped.end();
+      if (exact && label.back() != 'R') {
+        result.expressions[i] = label + "R" + result.expressions[i].substr(label.size());
+        label += 'R';
+      }
+    }
     for (const auto& [col, coef] : data.absorbs[i]) {
       const auto at = std::find(data.not_excited.begin(), data.not_excited.end(), col);
       result.data_regrouping(static_cast<Eigen::Index>(i), at - data.not_excited.begin()) = coef;
@@ -266,7 +297,8 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
     }
   }
   if (deficient)
-    not_excited_warnings(model, options.layout, result.base, based, data, result.warnings);
+    not_excited_warnings(model, options.layout, result.base, based, data, result.expressions,
+                         result.warnings);
   // estimate
   BlockEstimationOptions eo;
   eo.estimator = options.estimator;

@@ -272,6 +272,10 @@ DataIdentifiability data_identifiability(const EquationBlock& block,
     const int col = nonzero[c];
     if (is_kept[static_cast<size_t>(col)] || kept_local.empty()) continue;
     const Eigen::VectorXd k = solver.solve(Eigen::VectorXd(R.col(c)));
+    // Exactly dependent (to round-off, the floor below which no noise level matters) or only
+    // undetermined at this noise: the first is a regrouping of these data, named as such.
+    if ((R.col(c) - Rk * k).norm() <= options.roundoff_tolerance * smax)
+      out.regrouped.push_back(col);
     for (Eigen::Index i = 0; i < k.size(); ++i) {
       if (std::abs(k[i]) < options.absorb_threshold) continue;
       const int kc = out.kept[static_cast<size_t>(i)];

@@ -148,7 +148,11 @@ nlohmann::json vector_json(const Eigen::VectorXd& v) {
 nlohmann::json one_run(const ClosedLoopReport& r) {
   nlohmann::json j;
   j["dimensions_per_channel"] = r.rank;
+  nlohmann::json held = nlohmann::json::array();  // 1-based, as the joints are numbered in qr<J>
+  for (int h : r.held_joints) held.push_back(h + 1);
+  j["held_joints"] = held;
   if (r.method == ClosedLoopMethod::kProjection) {
+    if (r.reference_dimensions > 0) j["reference_dimensions"] = r.reference_dimensions;
     j["method"] = "projection";
     j["M1"] = r.m1;
     j["M2"] = r.m2;

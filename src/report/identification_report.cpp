@@ -21,6 +21,11 @@ namespace dynid {
 
 namespace {
 
+// The name a parameter is reported under (IdentificationResult::labels, else its base name).
+const std::string& reported_name(const IdentificationResult& r, size_t i) {
+  return r.labels.size() == r.names.size() ? r.labels[i] : r.names[i];
+}
+
 std::vector<std::string> joint_names(const Model& model) {
   std::vector<std::string> out;
   for (const Joint& j : model.joints) out.push_back(j.name);
@@ -80,13 +85,16 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
   nlohmann::json params = nlohmann::json::array();
   for (size_t i = 0; i < r.names.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
-    params.push_back({{"name", r.names[i]},
+    params.push_back({{"name", reported_name(r, i)},
                       {"value", json_number(e.x[k])},
                       {"std", json_number(e.std_dev[k])},
                       {"relative_std_percent", json_number(e.relative_std_percent[k])},
                       {"ci_low", json_number(e.ci_lower[k])},
                       {"ci_high", json_number(e.ci_upper[k])},
                       {"expression", r.expressions[i]}});
+    // A data regrouping's name (Fc2R) is what the user reads; the base parameter it extends is
+    // what validate, export and the completion look up.
+    if (reported_name(r, i) != r.names[i]) params.back()["base_name"] = r.names[i];
     if (e.std_dev_white.size() == e.x.size()) {
       params.back()["std_white"] = json_number(e.std_dev_white[k]);
       params.back()["ci_white_low"] = json_number(e.ci_lower_white[k]);
@@ -135,6 +143,7 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
                         {"rank", r.rank},
                         {"data_rank", r.data_rank},
                         {"not_excited", r.not_excited},
+                        {"data_regrouped", r.data_regrouped},
                         {"runs", runs},
                         {"excitation", excitation},
                         {"condition_number", json_number(r.condition_number)},
@@ -161,12 +170,13 @@ std::string identification_table(const Model& model, const IdentificationResult&
   const Estimate& e = r.estimate;
   std::ostringstream s;
   int pw = 10;
-  for (const auto& name : r.names) pw = std::max(pw, static_cast<int>(name.size()));
+  for (size_t i = 0; i < r.names.size(); ++i)
+    pw = std::max(pw, static_cast<int>(reported_name(r, i).size()));
   s << line("%-*s %14s %12s %9s   %-29s\n", pw, "parameter", "value", "std", "%std",
             (line("%.4g", 100 * e.confidence_level) + "% confidence interval").c_str());
   for (size_t i = 0; i < r.names.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
-    s << line("%-*s %14.6g %12.4g %9.2f   [%.6g, %.6g]\n", pw, r.names[i].c_str(), e.x[k],
+    s << line("%-*s %14.6g %12.4g %9.2f   [%.6g, %.6g]\n", pw, reported_name(r, i).c_str(), e.x[k],
               e.std_dev[k], e.relative_std_percent[k], e.ci_lower[k], e.ci_upper[k]);
   }
   s << line(
@@ -175,7 +185,15 @@ std::string identification_table(const Model& model, const IdentificationResult&
       100 * r.relative_error);
   if (!r.not_excited.empty()) {
     s << "data rank " << r.data_rank << " < " << r.rank << "; not excited (not estimated):";
-    for (const auto& name : r.not_excited) s << ' ' << name;
+    for (const auto& name : r.not_excited) {
+      if (std::find(r.data_regrouped.begin(), r.data_regrouped.end(), name) ==
+          r.data_regrouped.end())
+        s << ' ' << name;
+    }
+    if (!r.data_regrouped.empty()) {
+      s << "; regrouped on these data (see the R parameters' expressions):";
+      for (const auto& name : r.data_regrouped) s << ' ' << name;
+    }
     s << '\n';
   }
   if (r.runs.size() > 1) {
@@ -274,7 +292,9 @@ IdentifiedResultFile identification_result_from_json(const nlohmann::json& j,
       throw Error("'" + path + "': parameters[" + std::to_string(i) +
                   "] needs a string name and a numeric value");
     }
-    out.names.push_back(p["name"].get<std::string>());
+    // base_name: the base parameter a data regrouping (name Fc2R) extends, as identify writes it.
+    const bool based = p.contains("base_name") && p["base_name"].is_string();
+    out.names.push_back(based ? p["base_name"].get<std::string>() : p["name"].get<std::string>());
     out.values[static_cast<Eigen::Index>(i)] = p["value"].get<double>();
     if (!std::isfinite(out.values[static_cast<Eigen::Index>(i)])) {
       throw Error("'" + path + "': parameters[" + std::to_string(i) +

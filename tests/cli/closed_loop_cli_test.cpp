@@ -150,11 +150,20 @@ TEST(ClosedLoopCli, BadInputIsOneErrorLine) {
   write_csv(path("no_qr.csv"), {"t", "q1", "q2", "tau1", "tau2"}, plain);
   expect_error(id + path("no_qr.csv") + " --closed-loop projection", 1,
                "error: closed-loop identification needs the reference columns qr1..qr2");
+  // One joint held is seed 2's one-joint run; every joint held excites nothing.
   Eigen::MatrixXd flat(200, 7);
-  flat << plain.leftCols(3), plain.col(1), Eigen::VectorXd::Constant(200, 0.3), plain.rightCols(2);
+  flat << plain.leftCols(3), Eigen::VectorXd::Constant(200, 0.1),
+      Eigen::VectorXd::Constant(200, 0.3), plain.rightCols(2);
   write_csv(path("flat_qr.csv"), {"t", "q1", "q2", "qr1", "qr2", "tau1", "tau2"}, flat);
   expect_error(id + path("flat_qr.csv") + " --closed-loop projection", 1,
-               "error: reference qr2 is constant (0.3)");
+               "error: every reference qr1..qr2 is constant: the run excites nothing");
+  // The repeat's checks run before the whole-run estimate (368 s on seed 2's 25-period run
+  // before the refusal): the repeat's error, not the spectral preparation's, although both fail.
+  Eigen::MatrixXd drifting(200, 7);
+  drifting << plain.leftCols(3), plain.col(1), plain.col(2), plain.rightCols(2);
+  write_csv(path("drifting_qr.csv"), {"t", "q1", "q2", "qr1", "qr2", "tau1", "tau2"}, drifting);
+  expect_error(id + path("drifting_qr.csv") + " --closed-loop spectral --repeat periods", 1,
+               "error: --repeat periods needs a periodic reference with at least two periods");
   expect_error(id + data + " --closed-loop projection --fir 5000,5000", 1,
                "error: FIR orders M1 = 5000, M2 = 5000 need at least");
   expect_error(id + data + " --fir 4,4", 2, "error: --fir sets the projection's FIR orders");
@@ -206,6 +215,40 @@ TEST(ClosedLoopCli, NoIntervalDegreesOfFreedomLeftIsAWarningNotARefusal) {
     }
     r = run("validate --robot irp6 --params " + out + " --data " + path("irp6_run3.csv"));
     EXPECT_EQ(r.code, 0) << r.err;
+  }
+}
+
+// Issue 28 item 2: seed 2's one-joint Fourier run (joint 1 on the 4-harmonic test reference, joint
+// 2 held at 0.8 rad by its PID), 3 periods, through the binary: the spectral preparation with
+// Table 3's repeated statistic (it was refused, "reference qr2 is constant ... excite every
+// joint") and the projection (issue 28 item 3) with it.
+TEST(ClosedLoopCli, OneJointRunRepeatsOverItsPeriods) {
+  FourierCoefficients c = testing::planar2_reference();
+  c.a[1].setZero();
+  c.b[1].setZero();
+  const TrajectorySamples tr = sample_trajectory(FourierTrajectory(c), 100.0, false);
+  Eigen::MatrixXd data(tr.t.size(), 7);
+  data << tr.t, tr.q, tr.dq, tr.ddq;
+  write_csv(path("one_joint_ref.csv"), {"t", "q1", "q2", "dq1", "dq2", "ddq1", "ddq2"}, data);
+  auto r = run("simulate --robot planar2 --trajectory " + path("one_joint_ref.csv") +
+               " --engine native --controller pid --periods 3 --position-noise 1e-3 "
+               "--torque-noise 0.1 --seed 7 --out " +
+               path("one_joint_run.csv"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const std::string method : {"spectral", "projection"}) {
+    const std::string out = path("one_joint_" + method + ".json");
+    r = run("identify --robot planar2 --data " + path("one_joint_run.csv") + " --closed-loop " +
+            method + " --repeat periods --out " + out);
+    ASSERT_EQ(r.code, 0) << method << ": " << r.err;
+    const nlohmann::json j = load(out);
+    EXPECT_EQ(j["closed_loop"]["held_joints"], nlohmann::json({2})) << method;
+    EXPECT_EQ(j["closed_loop"]["dimensions_per_channel"], 9) << method;
+    EXPECT_EQ(j["repeated"]["n"], 3) << method;
+    EXPECT_FALSE(j["repeated"]["parameters"].empty()) << method;
+    for (const auto& p : j["repeated"]["parameters"]) {
+      EXPECT_TRUE(p["mean"].is_number()) << method << " " << p.dump();
+      EXPECT_TRUE(p["std"].is_number()) << method << " " << p.dump();
+    }
   }
 }
 

@@ -3,8 +3,10 @@
 // torque noise fed back through the controller, fixed seeds. Oracles: the model's own parameters
 // (the truth the plant ran with), Table 3's t ratio from Boost's Student-t (seed 2's printed
 // 0.6795), and an explicit projection of a hand-made signal.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -26,14 +28,9 @@ struct ClosedRun {
 };
 
 // Plain PID (no feed-forward), noise fed back, `periods` periods after a dropped start-up one, on
-// the planar2 test reference truncated to its first `harmonics` (≤ 4).
-ClosedRun plain_pid_run_harmonics(const Model& m, unsigned seed, int periods, int harmonics,
-                                  double q_noise, double tau_noise) {
-  FourierCoefficients c = testing::planar2_reference();
-  for (int j = 0; j < 2; ++j) {
-    for (int h = harmonics; h < 4; ++h) c.a[static_cast<size_t>(j)][h] = 0.0;
-    for (int h = harmonics; h < 4; ++h) c.b[static_cast<size_t>(j)][h] = 0.0;
-  }
+// the reference `c`.
+ClosedRun plain_pid_run_of(const Model& m, const FourierCoefficients& c, unsigned seed, int periods,
+                           double q_noise, double tau_noise) {
   const TrajectorySamples tr = sample_trajectory(FourierTrajectory(c), kRate, false);
   SimulateOptions so = testing::noisy_sensors(q_noise, tau_noise, seed, periods + 1);
   so.feed_forward = FeedForward::kNone;
@@ -44,6 +41,17 @@ ClosedRun plain_pid_run_harmonics(const Model& m, unsigned seed, int periods, in
   out.run = {r.t.tail(rows), r.q.bottomRows(rows), {}, {}, r.tau.bottomRows(rows)};
   out.reference.qr = r.qr.bottomRows(rows);
   return out;
+}
+
+// The planar2 test reference truncated to its first `harmonics` (≤ 4).
+ClosedRun plain_pid_run_harmonics(const Model& m, unsigned seed, int periods, int harmonics,
+                                  double q_noise, double tau_noise) {
+  FourierCoefficients c = testing::planar2_reference();
+  for (int j = 0; j < 2; ++j) {
+    for (int h = harmonics; h < 4; ++h) c.a[static_cast<size_t>(j)][h] = 0.0;
+    for (int h = harmonics; h < 4; ++h) c.b[static_cast<size_t>(j)][h] = 0.0;
+  }
+  return plain_pid_run_of(m, c, seed, periods, q_noise, tau_noise);
 }
 
 ClosedRun plain_pid_run(const Model& m, unsigned seed, int periods, double q_noise,
@@ -248,10 +256,10 @@ TEST(ClosedLoopIdentification, BadReferencesAreClearErrors) {
             "closed-loop identification needs the reference columns qr1..qr2 in the run: log the "
             "controller's reference (dynid simulate writes them)");
   ReferenceRecord flat = c.reference;
-  flat.qr.col(0).setConstant(0.5);
+  flat.qr.setConstant(0.5);  // one held joint is a one-joint run; all held is nothing
   EXPECT_EQ(testing::error_of([&] { identify(m, {c.run}, {flat}, o); }),
-            "reference qr1 is constant (0.5): it drives nothing the projection can use; excite "
-            "every joint");
+            "every reference qr1..qr2 is constant: the run excites nothing; move at least one "
+            "joint");
   ReferenceRecord drifting = c.reference;
   for (Eigen::Index k = 0; k < drifting.qr.rows(); ++k) drifting.qr(k, 0) += 1e-3 * k;
   EXPECT_EQ(testing::error_of([&] {
@@ -326,6 +334,135 @@ TEST(ClosedLoopIdentification, NoIntervalDegreesOfFreedomLeftStillGivesAnEstimat
   // Intervals of the right size, not merely wide: the errors in units of σ spread by about 1.
   EXPECT_GT(rms_z, 0.4);
   EXPECT_LT(rms_z, 2.0);
+}
+
+// Seed 2 section 3 moves one joint at a time, the others held by their controllers (constant
+// references). planar2 with viscous friction and offsets (no Coulomb friction in the plant: its
+// band-limited sign biases Fv1 and Fc1 on every run alike, see the first test), joint 1 on the
+// 4-harmonic test reference, joint 2 held at 0.8 rad, 4 periods under a plain PID.
+Model one_joint_plant() {
+  Model m = load_robot("planar2");
+  m.joints[0].friction.Fv = 1.5;
+  m.joints[0].friction.Fo = 0.3;
+  m.joints[1].friction.Fv = 0.8;
+  m.joints[1].friction.Fo = -0.2;
+  return m;
+}
+
+ClosedRun one_joint_run(const Model& m, unsigned seed, int periods) {
+  FourierCoefficients c = testing::planar2_reference();
+  c.a[1].setZero();
+  c.b[1].setZero();
+  return plain_pid_run_of(m, c, seed, periods, 1e-3, 0.1);
+}
+
+IdentifyOptions one_joint_options(ClosedLoopMethod method) {
+  IdentifyOptions o = closed_options(method);
+  o.layout.coulomb = false;
+  return o;
+}
+
+// What each estimate stands for on these data (its base parameter plus the data regrouping of
+// the ones the run does not excite), from the plant's own parameters.
+Eigen::VectorXd standing_truth(const Model& m, const IdentificationResult& r,
+                               const ParameterLayout& layout) {
+  return estimated_base_values(r, r.base.reduce(layout.parameters(m)));
+}
+
+// Issue 28 item 3: the projection method on a one-joint run, as seed 2 applies it (only the
+// spectral variant accepted one; the projection refused "reference qr2 is constant"). The FIR is
+// fitted on the moving reference; its automatic order keeps the 9 dimensions a 4-harmonic
+// reference spans (M = 2 kept 7); the held joint is taken as still. Both methods recover what the
+// run excites, the plant's truth inside the 99.9 % intervals.
+TEST(ClosedLoopIdentification, OneJointRunsByProjectionAndSpectralLines) {
+  const Model m = one_joint_plant();
+  const ClosedRun c = one_joint_run(m, 41, 4);
+  ASSERT_EQ(c.reference.qr.col(1).maxCoeff(), c.reference.qr.col(1).minCoeff());
+  for (const ClosedLoopMethod method :
+       {ClosedLoopMethod::kProjection, ClosedLoopMethod::kSpectral}) {
+    const IdentifyOptions o = one_joint_options(method);
+    const IdentificationResult r = identify(m, {c.run}, {c.reference}, o);
+    ASSERT_EQ(r.closed_loop.size(), 1u);
+    const ClosedLoopReport& rep = r.closed_loop[0];
+    EXPECT_EQ(rep.held_joints, std::vector<int>{1});
+    EXPECT_EQ(rep.rank, 9);  // 2·4 lines + the constant, per channel
+    if (method == ClosedLoopMethod::kProjection) {
+      EXPECT_EQ(rep.reference_dimensions, 9);
+      EXPECT_TRUE(rep.test_passed);
+    }
+    EXPECT_FALSE(r.not_excited.empty());  // link 2's own parameters, joint 2's friction
+    const Eigen::VectorXd truth = standing_truth(m, r, o.layout);
+    int outside = 0;
+    for (Eigen::Index i = 0; i < truth.size(); ++i) {
+      const bool out = truth[i] < r.estimate.ci_lower[i] || truth[i] > r.estimate.ci_upper[i];
+      outside += out;
+      std::printf("%s %-6s %9.4g truth %9.4g  [%9.4g, %9.4g]%s\n",
+                  method == ClosedLoopMethod::kProjection ? "projection" : "spectral  ",
+                  r.names[static_cast<size_t>(i)].c_str(), r.estimate.x[i], truth[i],
+                  r.estimate.ci_lower[i], r.estimate.ci_upper[i], out ? "  OUTSIDE" : "");
+    }
+    EXPECT_EQ(outside, 0);
+  }
+}
+
+// Issue 28 item 2: Table 3's repeated statistic on a one-joint run (it was refused, "reference qr2
+// is constant ... excite every joint", and only after the whole-run estimate). Every period is
+// identified alone. Oracles: the plant's truth lies inside the whole run's intervals; spectral:
+// least squares on the same lines of every period makes the whole-run estimate the mean of the
+// per-period ones, so they agree within Table 3's half-width; projection (its one-period FIR
+// windows lose their ends): the mean lies within the whole run's half-width of the truth. Table 3
+// measures repeatability only: a model error common to every period (the held joint moves by its
+// tracking error while the equations take it as still) shifts every period alike (ZZ1R: 2.52 on
+// every period for 2.17), which no spread over periods can show. The request's checks run in
+// repeated_pieces(), before any estimate.
+TEST(ClosedLoopIdentification, RepeatedPeriodsOfAOneJointRun) {
+  const Model m = one_joint_plant();
+  const ClosedRun c = one_joint_run(m, 43, 4);
+  for (const ClosedLoopMethod method :
+       {ClosedLoopMethod::kSpectral, ClosedLoopMethod::kProjection}) {
+    const IdentifyOptions o = one_joint_options(method);
+    const RepeatedPieces pieces = repeated_pieces({c.run}, {c.reference}, o, RepeatOver::kPeriods);
+    ASSERT_EQ(pieces.runs.size(), 4u);
+    ASSERT_EQ(pieces.references.size(), 4u);
+    const RepeatedEstimate rep = identify_repeated(m, pieces, o);
+    EXPECT_EQ(rep.n, 4);
+    ASSERT_FALSE(rep.names.empty());
+    const IdentificationResult whole = identify(m, {c.run}, {c.reference}, o);
+    const Eigen::VectorXd truth = standing_truth(m, whole, o.layout);
+    int compared = 0;
+    for (size_t i = 0; i < rep.names.size(); ++i) {
+      const auto at = std::find(whole.names.begin(), whole.names.end(), rep.names[i]);
+      if (at == whole.names.end()) continue;  // determined on one period, not on the whole run
+      const auto w = at - whole.names.begin();
+      const auto k = static_cast<Eigen::Index>(i);
+      ++compared;
+      std::printf("%s %-5s periods %8.4g ± %-8.3g whole run %8.4g [%8.4g, %8.4g] truth %8.4g\n",
+                  method == ClosedLoopMethod::kProjection ? "projection" : "spectral  ",
+                  rep.names[i].c_str(), rep.mean[k], rep.ci_half_width[k], whole.estimate.x[w],
+                  whole.estimate.ci_lower[w], whole.estimate.ci_upper[w], truth[w]);
+      if (method == ClosedLoopMethod::kSpectral) {
+        EXPECT_LE(std::abs(rep.mean[k] - whole.estimate.x[w]), rep.ci_half_width[k])
+            << rep.names[i];
+      } else {
+        // The FIR window of one period loses M samples at each end, so the periods are not the
+        // whole run cut in four: their mean is another estimate, as uncertain as the whole run's.
+        const double half = 0.5 * (whole.estimate.ci_upper[w] - whole.estimate.ci_lower[w]);
+        EXPECT_LE(std::abs(rep.mean[k] - truth[w]), half) << rep.names[i];
+      }
+      EXPECT_GE(truth[w], whole.estimate.ci_lower[w]) << rep.names[i];
+      EXPECT_LE(truth[w], whole.estimate.ci_upper[w]) << rep.names[i];
+    }
+    EXPECT_GE(compared, 5);
+  }
+  // A reference that does not repeat is refused by the plan, with the repeat's own message.
+  ReferenceRecord drifting = c.reference;
+  for (Eigen::Index k = 0; k < drifting.qr.rows(); ++k) drifting.qr(k, 0) += 1e-3 * k;
+  EXPECT_EQ(testing::error_of([&] {
+              repeated_pieces({c.run}, {drifting}, one_joint_options(ClosedLoopMethod::kSpectral),
+                              RepeatOver::kPeriods);
+            }),
+            "--repeat periods needs a periodic reference with at least two periods in the run: qr "
+            "does not repeat (run 1)");
 }
 
 }  // namespace

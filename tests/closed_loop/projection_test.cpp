@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -96,6 +97,19 @@ TEST(Projection, ChoosesTheSmallestAdequateOrderAndRecoversAKnownFir) {
   EXPECT_DOUBLE_EQ(g.processed.record.t[0], d.run.t[11]);
   ASSERT_EQ(g.tests.size(), 1u);
   EXPECT_TRUE(g.tests[0].passed);
+  EXPECT_TRUE(g.warnings.empty());
+  // Given orders that miss taps fail the test: a warning that says so and names the fix, not
+  // only the status of the test (issue 28 item 3).
+  o.m1 = o.m2 = 2;
+  const ProjectionResult short_fir = project_on_reference(d.run, d.qr, d.dqr, d.ddqr, o);
+  ASSERT_FALSE(short_fir.tests.back().passed);
+  ASSERT_EQ(short_fir.warnings.size(), 1u);
+  EXPECT_EQ(short_fir.warnings[0].rfind("the torque remainder of the projection still correlates "
+                                        "with the reference",
+                                        0),
+            0u)
+      << short_fir.warnings[0];
+  EXPECT_NE(short_fir.warnings[0].find("give larger orders with --fir"), std::string::npos);
 }
 
 // One 2 s period of a three-harmonic reference per joint at 200 Hz.
@@ -191,10 +205,10 @@ TEST(Projection, BadInputIsAClearError) {
       "projection needs the reference columns qr1..qr2 in the run: log the controller's "
       "reference (dynid simulate writes them)");
   Eigen::MatrixXd flat = d.qr;
-  flat.col(1).setConstant(0.25);
+  flat.setConstant(0.25);
   EXPECT_EQ(testing::error_of([&] { project_on_reference(d.run, flat, d.dqr, d.ddqr); }),
-            "reference qr2 is constant (0.25): it drives nothing the projection can use; excite "
-            "every joint");
+            "every reference qr1..qr2 is constant: the run excites nothing; move at least one "
+            "joint");
   ProjectionOptions o;
   o.m1 = 50;
   o.m2 = 50;
@@ -211,6 +225,74 @@ TEST(Projection, BadInputIsAClearError) {
   bad(5, 0) = std::nan("");
   EXPECT_EQ(testing::error_of([&] { project_on_reference(d.run, bad, d.dqr, d.ddqr); }),
             "projection: qr contains NaN or Inf");
+}
+
+// A held joint (constant reference, seed 2's one-joint runs) is in the span of the FIR's constant:
+// the FIR is fitted on the moving reference and recovers its taps as well as with both moving
+// (within 0.03), the held reference's rows of the coefficients are zero, and the held joint's
+// projected velocity and acceleration are zero.
+TEST(Projection, HeldJointIsLeftOutOfTheFirAndTakenAsStill) {
+  FirData d = fir_data(8000, 23);
+  // Reference 2 held: it no longer drives the torques (its former contribution taken out).
+  const long m = d.qr.rows();
+  for (long t = 0; t < m; ++t)
+    for (int j = 0; j < 2; ++j)
+      for (int k = -3; k <= 10; ++k)
+        if (t - k >= 0 && t - k < m) d.run.tau(t, j) -= tap(j, 1, k) * d.qr(t - k, 1);
+  Eigen::MatrixXd qr = d.qr;
+  qr.col(1).setConstant(0.25);
+  const ProjectionResult p = project_on_reference(d.run, qr, d.dqr, d.ddqr);
+  EXPECT_EQ(p.held_joints, std::vector<int>{1});
+  EXPECT_TRUE(p.tests.back().passed);
+  EXPECT_EQ(p.m1, 12);  // the taps of reference 1 reach lag 10, as with both moving
+  const int w = p.m1 + p.m2 + 1;
+  ASSERT_EQ(p.fir.rows(), 2 * w + 1);
+  EXPECT_EQ(p.fir.middleRows(w, w).cwiseAbs().maxCoeff(), 0.0);
+  for (int j = 0; j < 2; ++j)
+    for (int k = -p.m1; k <= p.m2; ++k)
+      EXPECT_NEAR(p.fir(k + p.m1, j), tap(j, 0, k), 0.03) << j << " " << k;
+  EXPECT_EQ(p.processed.record.dq.col(1).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(p.processed.record.ddq.col(1).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_GT(p.processed.record.dq.col(0).cwiseAbs().maxCoeff(), 0.0);
+}
+
+// The automatic order keeps every dimension a periodic reference spans (options.min_rank = 2L + 1,
+// which prepare_closed_loop sets from the reference's lines): a 3-harmonic reference held by one
+// joint spans 7, which M = 2 (5 lags and the constant) cannot keep even when its remainder passes.
+TEST(Projection, AutomaticOrderKeepsTheDimensionsTheReferenceSpans) {
+  Eigen::VectorXd t1;
+  Eigen::MatrixXd q1, dq1, ddq1;
+  three_harmonics(t1, q1, dq1, ddq1);
+  const Eigen::Index period = t1.size(), m = 6 * period;
+  JointRecord run;
+  run.t = Eigen::VectorXd::LinSpaced(m, 0.0, (m - 1) * 0.005);
+  Eigen::MatrixXd qr(m, 2), dqr(m, 2), ddqr(m, 2);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    qr.row(k) << q1(k % period, 0), 0.3;
+    dqr.row(k) << dq1(k % period, 0), 0.0;
+    ddqr.row(k) << ddq1(k % period, 0), 0.0;
+  }
+  // Torque: a two-tap response to the reference plus white noise; position: the reference.
+  std::mt19937_64 rng(29);
+  std::normal_distribution<double> g(0.0, 0.05);
+  run.tau.resize(m, 2);
+  run.q = qr;
+  for (Eigen::Index k = 0; k < m; ++k) {
+    const double prev = k > 0 ? qr(k - 1, 0) : qr(m - 1, 0);
+    run.tau.row(k) << 2.0 * qr(k, 0) - 0.5 * prev + g(rng), 0.4 * qr(k, 0) + g(rng);
+  }
+  const ProjectionResult free = project_on_reference(run, qr, dqr, ddqr);
+  ProjectionOptions o;
+  o.min_rank = 7;
+  const ProjectionResult kept = project_on_reference(run, qr, dqr, ddqr, o);
+  std::printf("without min_rank: M = %d, rank %d; with min_rank 7: M = %d, rank %d\n", free.m1,
+              free.projector->rank(), kept.m1, kept.projector->rank());
+  EXPECT_EQ(free.m1, 2);
+  EXPECT_LT(free.projector->rank(), 7);
+  EXPECT_GT(kept.m1, 2);
+  EXPECT_EQ(kept.projector->rank(), 7);
+  EXPECT_TRUE(kept.tests.back().passed);
+  EXPECT_TRUE(kept.warnings.empty());
 }
 
 }  // namespace

@@ -177,6 +177,34 @@ TEST(DataIdentifiability, ZeroAndRepeatedColumnsAreNotExcitedAndTheirShareIsName
   EXPECT_EQ(d.absorbs[0][0].first, 3);
   EXPECT_NEAR(d.absorbs[0][0].second, 2.0, 1e-12);
   EXPECT_TRUE(d.absorbs[1].empty());
+  // The repeated column is regrouped exactly; the zero one has nothing to regroup.
+  EXPECT_EQ(d.regrouped, std::vector<int>{3});
+}
+
+// Issue 28 item 7: a column equal to a kept one up to round-off is a regrouping of the data; a
+// column the noise leaves undetermined (nearly, not exactly, collinear: the statistical rule of
+// issue 25) is not, and keeps being only not excited.
+TEST(DataIdentifiability, ExactlyCollinearColumnsAreRegroupedNoisyOnesOnlyNotDetermined) {
+  std::mt19937 rng(11);
+  EquationBlock b;
+  b.W = estimation_testing::gaussian(200, 4, rng);
+  const Eigen::MatrixXd wiggle = estimation_testing::gaussian(200, 1, rng);
+  b.W.col(2) = b.W.col(0) + b.W.col(1) + 1e-15 * wiggle;  // = a + b to round-off
+  b.W.col(3) = b.W.col(1) + 1e-4 * wiggle;                // not exact: 1e-4 off
+  b.columns = {"a", "b", "c", "d"};
+  const Eigen::Vector4d theta(1.0, 2.0, 3.0, 4.0);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  b.y = b.W * theta;
+  for (Eigen::Index i = 0; i < b.y.size(); ++i) b.y[i] += noise(rng);
+  const DataIdentifiability d = data_identifiability(b);
+  EXPECT_EQ(d.kept, (std::vector<int>{0, 1}));
+  EXPECT_EQ(d.not_excited, (std::vector<int>{2, 3}));
+  EXPECT_EQ(d.regrouped, std::vector<int>{2});
+  // Without noise the 1e-4 difference is determined (only the round-off floor applies).
+  b.y = b.W * theta;
+  const DataIdentifiability exact = data_identifiability(b);
+  EXPECT_EQ(exact.kept, (std::vector<int>{0, 1, 3}));
+  EXPECT_EQ(exact.regrouped, std::vector<int>{2});
 }
 
 // Issue 25 item 1, the statistical rule: columns a, a + δ·e and c (2000 Gaussian rows, y = their

@@ -25,16 +25,23 @@ struct ClosedLoopRun {
   /// Per joint std of τ − τ̂ on the kept samples [N·m or N]: the torque noise the projection
   /// removes (maximum likelihood's torque noise after a projection when none is given).
   Eigen::VectorXd torque_remainder_std;
+  /// What the user should know about the preparation (identify() adds them to the result's
+  /// warnings): a FIR order whose remainder fails the test, a reference dimension it cannot keep.
+  std::vector<std::string> warnings;
 };
 
 /// The prepare stage of closed-loop identification. Projection: project_on_reference() with the
 /// reference's derivatives as given, else derived from qr (exactly, by its Fourier series, when
 /// qr is periodic to 1e-9 of its range; else by central differences of the noise-free qr).
+/// The projection's automatic FIR order also keeps the 2L + 1 dimensions of a periodic
+/// reference with L lines (ProjectionOptions::min_rank, seed 2 eqs. 10–12).
+/// A joint whose reference is constant (held: seed 2 section 3's one-joint runs) is taken as still
+/// by both methods (dq, ddq zero; ClosedLoopReport::held_joints).
 /// Spectral: the last whole periods of the run (period detected from qr, exact to 1e-9), q and τ
 /// kept on the harmonics 0…H of f0 (H = the reference's highest line), q̂' and q̂'' by iω and −ω²
 /// on those lines (no finite difference). run: t uniform [s], q, tau m × n; dq, ddq ignored.
 /// Processing choices are appended to `choices`. Throws dynid::Error for no or mismatched
-/// reference columns, a constant reference (named), a reference that is not periodic (spectral),
+/// reference columns, every reference constant, a reference that is not periodic (spectral),
 /// fewer than two whole periods, and as project_on_reference().
 ClosedLoopRun prepare_closed_loop(const JointRecord& run, const ReferenceRecord& reference,
                                   const ClosedLoopIdOptions& options,
@@ -106,10 +113,31 @@ enum class RepeatOver {
   kRuns      ///< each run
 };
 
-/// Seed 2 Table 3: identify() on each period (or run) alone, then repeated_statistics() of the
-/// estimates at options.confidence_level. references: one per run, or empty (kRuns without a
-/// closed-loop method only). Throws dynid::Error for kPeriods without references or with a
-/// reference that is not periodic, fewer than 2 periods or runs, and as identify().
+/// The pieces `identify --repeat` identifies one by one: each whole period of each run, or each
+/// run, with its reference (periods: the reference's derivatives from its Fourier series over the
+/// whole run, so that one period can be told periodic).
+struct RepeatedPieces {
+  std::vector<JointRecord> runs;
+  std::vector<ReferenceRecord> references;  ///< one per piece, or empty (no closed-loop method)
+};
+
+/// Splits runs into RepeatedPieces with every check that can refuse the request, so that a caller
+/// runs it before any estimate (the comau-s2 25-period run spent 368 s on the whole-run estimate
+/// before the repeat was refused). A held joint (constant reference; seed 2's one-joint runs) is
+/// accepted. references: one per run, or empty (kRuns without a closed-loop method only).
+/// Throws dynid::Error for kPeriods without a reference per run, every reference of a run
+/// constant, a reference that is not periodic with two periods in its run, fewer than 2 pieces,
+/// and a closed-loop method without a reference per run.
+RepeatedPieces repeated_pieces(const std::vector<JointRecord>& runs,
+                               const std::vector<ReferenceRecord>& references,
+                               const IdentifyOptions& options, RepeatOver over);
+
+/// Seed 2 Table 3: identify() on each piece alone, then repeated_statistics() of the estimates at
+/// options.confidence_level. Throws as identify() does on a piece.
+RepeatedEstimate identify_repeated(const Model& model, const RepeatedPieces& pieces,
+                                   const IdentifyOptions& options);
+
+/// repeated_pieces() then identify_repeated() on them. Throws as those do.
 RepeatedEstimate identify_repeated(const Model& model, const std::vector<JointRecord>& runs,
                                    const std::vector<ReferenceRecord>& references,
                                    const IdentifyOptions& options, RepeatOver over);

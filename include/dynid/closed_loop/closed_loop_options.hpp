@@ -11,12 +11,18 @@ struct ProjectionOptions {
   int m1 = -1;  ///< non-causal lags (future reference samples, seed 2 eq. 10); −1 = choose
   int m2 =
       -1;  ///< causal lags (past reference samples); −1 = choose (m1, m2 both given or both −1)
-  int max_order = 128;         ///< largest M1 = M2 tried when choosing
+  /// Largest M1 = M2 tried when choosing, unless a larger one (as long as the run allows) is
+  /// needed to keep min_rank dimensions.
+  int max_order = 128;
   double significance = 0.01;  ///< family-wise level of the remainder–reference correlation test
   int test_lags = -1;  ///< largest |lag| tested; −1 = max(100, 3·max(M1, M2)), at most m/4
   double rank_tolerance = 1e-10;  ///< eigenvalues of the lagged-reference Gram below this × the
                                   ///< largest are dropped (a few-harmonic reference spans few
                                   ///< dimensions; the projection is still unique)
+  /// Dimensions the reference spans (2L + 1 for a periodic reference with L lines, the constant
+  /// included; prepare_closed_loop sets it): the automatic order is the smallest that keeps at
+  /// least this many as well as passing the test. 0 = no such requirement.
+  int min_rank = 0;
 };
 
 /// How identify() prepares a closed-loop run (docs/design.md §8, "prepare"; seed 2 §2.2 and §3.4).
@@ -80,13 +86,15 @@ struct ExcitationSpectrum {
 /// What the closed-loop preparation of one run chose and found (reported in the result JSON).
 struct ClosedLoopReport {
   ClosedLoopMethod method = ClosedLoopMethod::kNone;
-  int rank = 0;                 ///< dimensions per projected channel (interval dof per joint)
-  int m1 = 0, m2 = 0;           ///< projection: FIR orders used
-  Eigen::VectorXd correlation;  ///< projection: per joint corr(û, ũ) (seed 2 reports 2.9e-14)
-  double max_z = 0.0;           ///< projection: remainder–reference test statistic
-  double threshold = 0.0;       ///< projection: its Bonferroni bound
-  bool test_passed = false;     ///< projection: max_z ≤ threshold
-  ExcitationSpectrum spectrum;  ///< spectral: the lines kept
+  int rank = 0;                  ///< dimensions per projected channel (interval dof per joint)
+  int m1 = 0, m2 = 0;            ///< projection: FIR orders used
+  Eigen::VectorXd correlation;   ///< projection: per joint corr(û, ũ) (seed 2 reports 2.9e-14)
+  double max_z = 0.0;            ///< projection: remainder–reference test statistic
+  double threshold = 0.0;        ///< projection: its Bonferroni bound
+  bool test_passed = false;      ///< projection: max_z ≤ threshold
+  ExcitationSpectrum spectrum;   ///< spectral: the lines kept
+  int reference_dimensions = 0;  ///< projection: 2L + 1 for a periodic reference, else 0
+  std::vector<int> held_joints;  ///< joints (0-based) whose reference is constant, taken as still
 };
 
 }  // namespace dynid

@@ -75,8 +75,12 @@ struct RunSummary {
 
 /// Everything identify() found, ready to be written as the JSON of docs/design.md §4.
 struct IdentificationResult {
-  std::vector<std::string> names;           ///< base parameter names (ZZ1R, …, Fv1, …)
-  std::vector<std::string> expressions;     ///< regrouping expressions, one per base parameter
+  std::vector<std::string> names;        ///< base parameter names (ZZ1R, …, Fv1, …)
+  std::vector<std::string> expressions;  ///< regrouping expressions, one per base parameter
+  /// Per name, the name reported: names[i] + "R" when these data regroup into it a parameter of
+  /// data_regrouped (Fc2R = Fc2 + Fcm3, as the base set names its regroupings), else names[i].
+  /// names[i] stays the identifier every lookup in base.names uses. Empty = names.
+  std::vector<std::string> labels;
   std::vector<std::string> unidentifiable;  ///< standard parameters with no effect at all
   Estimate estimate;                        ///< values, σ, %σ, CI, residual statistics, summary
   int rank = 0;                             ///< base parameters (model rank)
@@ -105,6 +109,10 @@ struct IdentificationResult {
   /// parameter); names/estimate hold only the data-identifiable ones.
   int data_rank = 0;
   std::vector<std::string> not_excited;  ///< base parameters the data do not determine
+  /// Of not_excited: those whose column is a combination of the estimated ones to round-off on
+  /// these data (DataIdentifiability::regrouped), regrouped exactly into the parameters that
+  /// absorb them (labels) rather than left undetermined by the noise.
+  std::vector<std::string> data_regrouped;
   /// names.size() × not_excited.size(): on these data each estimate is its base parameter plus
   /// data_regrouping·θ(not_excited) (the data cannot separate them); its expression says so.
   Eigen::MatrixXd data_regrouping;

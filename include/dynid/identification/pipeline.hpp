@@ -72,6 +72,12 @@ struct DataIdentifiability {
   /// Per kept column, the not-excited columns it absorbs on these data (name, coefficient): the
   /// kept estimate is θ_kept + Σ c·θ_not_excited (a data regrouping, like K_d for the model).
   std::vector<std::vector<std::pair<int, double>>> absorbs;
+  /// Of not_excited: the columns that are combinations of the kept ones to round-off (distance to
+  /// their span at most roundoff_tolerance × σ_max of the column-scaled W), e.g. the Coulomb
+  /// column of a coupled motor that turns with the one joint that moves. The data regroup them
+  /// exactly into the kept ones that absorb them, as the model's base set regroups columns; the
+  /// other not-excited columns are the ones the noise leaves undetermined. Increasing.
+  std::vector<int> regrouped;
 };
 
 /// Options of data_identifiability (Ceres style).
