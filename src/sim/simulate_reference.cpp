@@ -32,28 +32,34 @@ constexpr Eigen::Index kGainConfigurations = 64;
 // gravity torque along the reference (the integral removes it within kp/ki = 2 s).
 constexpr double kGravityErrorBudget = 0.02;
 
+// Checks rate and delay, sets the sample time and derivative filter of `o`, and returns the loop's
+// bandwidth ω [rad/s]: well below the sample rate (rate/40) and below the inverse of its lag, with
+// a derivative filter of at least two samples.
+double loop_timing(double rate_hz, int delay_samples, PidOptions& o) {
+  if (!(rate_hz > 0.0) || !std::isfinite(rate_hz))
+    throw Error("controller rate must be finite and > 0 Hz, got " + short_number(rate_hz));
+  if (delay_samples < 0)
+    throw Error("measurement delay must be >= 0 samples, got " + std::to_string(delay_samples));
+  o.sample_time = 1.0 / rate_hz;
+  o.derivative_filter_time = std::max(o.derivative_filter_time, 2.0 / rate_hz);
+  const double lag = (delay_samples + 1) * o.sample_time + o.derivative_filter_time;
+  double w = 2 * M_PI * std::min(8.0, rate_hz / 40.0);
+  if (delay_samples > 0) w = std::min(w, kLoopLagBudget / lag);  // inactive without delay
+  return w;
+}
+
 }  // namespace
 
 PidOptions reference_pid_options(const Model& model,
                                  const Eigen::Ref<const Eigen::MatrixXd>& q_reference,
                                  double rate_hz, int delay_samples, FeedForward feed_forward) {
-  if (!(rate_hz > 0.0) || !std::isfinite(rate_hz))
-    throw Error("controller rate must be finite and > 0 Hz, got " + short_number(rate_hz));
-  if (delay_samples < 0)
-    throw Error("measurement delay must be >= 0 samples, got " + std::to_string(delay_samples));
   const int n = model.dof();
   if (q_reference.cols() != n || q_reference.rows() < 1 || !q_reference.allFinite())
     throw Error("controller gains: the reference must be finite, samples x " + std::to_string(n) +
                 " joints, got " + std::to_string(q_reference.rows()) + " x " +
                 std::to_string(q_reference.cols()));
   PidOptions o;
-  o.sample_time = 1.0 / rate_hz;
-  o.derivative_filter_time = std::max(o.derivative_filter_time, 2.0 / rate_hz);
-  // A discrete loop needs its bandwidth well below the sample rate (rate/40) and below the
-  // inverse of its lag; a derivative filter of at least two samples.
-  const double lag = (delay_samples + 1) * o.sample_time + o.derivative_filter_time;
-  double w = 2 * M_PI * std::min(8.0, rate_hz / 40.0);
-  if (delay_samples > 0) w = std::min(w, kLoopLagBudget / lag);  // inactive without delay
+  const double w = loop_timing(rate_hz, delay_samples, o);
   // The configurations the loop will meet: M(q) and g(q) vary along the reference (iiwa14's
   // joint 1 inertia tenfold), so q0 alone does not represent them.
   const Eigen::Index m = q_reference.rows();
@@ -114,7 +120,32 @@ PidOptions reference_pid_options(const Model& model,
 
 PidOptions default_pid_options(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q0,
                                double rate_hz, int delay_samples, FeedForward feed_forward) {
-  return reference_pid_options(model, q0.transpose(), rate_hz, delay_samples, feed_forward);
+  Workspace ws(model);
+  Eigen::MatrixXd M(model.dof(), model.dof());
+  mass_matrix(model, ws, q0, M);
+  PidOptions o;
+  const double w = loop_timing(rate_hz, delay_samples, o);
+  // Gains per joint ∝ M_jj place the modes of M·ë = −K·e at ω·sqrt(μ), μ the eigenvalues of
+  // M⁻¹·diag(M) ≥ 1 on average; coupling (planar2's elbow, a 7-joint arm's light wrist) makes
+  // μ_max ≫ 1, a fast mode a delayed or feedback-only loop cannot hold. Dividing by μ_max keeps
+  // every mode at or below ω. The delay-free feed-forward loop keeps its historical gains, which
+  // recorded runs and validate_run_by_simulation() rely on.
+  double mu_max = 1.0;
+  if (delay_samples > 0 || feed_forward == FeedForward::kNone) {
+    const Eigen::VectorXd d_sqrt = M.diagonal().cwiseSqrt();
+    const Eigen::MatrixXd scaled =
+        d_sqrt.asDiagonal() * M.ldlt().solve(Eigen::MatrixXd(d_sqrt.asDiagonal()));
+    mu_max = std::max(1.0, Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(
+                               0.5 * (scaled + scaled.transpose()), Eigen::EigenvaluesOnly)
+                               .eigenvalues()
+                               .maxCoeff());
+  }
+  o.kp = M.diagonal() * w * w / mu_max;  // this order: bit-identical historical gains at μ = 1
+  o.kd = M.diagonal() * 2 * 0.9 * w / mu_max;
+  o.ki = o.kp * 0.5;
+  o.feed_forward = feed_forward;
+  o.effort_limit = Eigen::VectorXd::Constant(model.dof(), 1e6);
+  return o;
 }
 
 PidOptions simulation_pid_options(const Model& model,

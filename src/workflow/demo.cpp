@@ -91,7 +91,7 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
   po.engine = o.mujoco ? PlantEngine::kMujoco : PlantEngine::kNative;
   po.dt = 1.0 / o.rate;
   auto plant = make_plant(model, po);
-  PidController pid(model, reference_pid_options(model, traj.q, o.rate));
+  PidController pid(model, default_pid_options(model, traj.q.row(0).transpose(), o.rate));
   SensorOptions so;
   so.counts_per_rev = 1 << 20;
   so.position_noise_std = o.position_noise;
@@ -175,7 +175,7 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
                                    Eigen::VectorXd::Constant(n, 3.0), 0.5);
   const TrajectorySamples mv = sample_trajectory(move, o.rate, true);
   auto plant2 = make_plant(model, po);
-  PidController pid2(model, reference_pid_options(model, mv.q, o.rate));
+  PidController pid2(model, default_pid_options(model, mv.q.row(0).transpose(), o.rate));
   so.seed = o.seed + 1;
   Sensors sensors2(model, so);
   co.periods = 1;

@@ -139,8 +139,8 @@ TEST(ControllerChoice, RuleBoundsTheCoupledModeAndTheLag) {
   const double d1 = a - b * b / c, d2 = c - b * b / a;
   const double mu_max = 1.0 + b / std::sqrt(a * c);
   const double w = 2 * M_PI * 5.0;  // 2π·rate/40 at 200 Hz
-  const PidOptions ff = default_pid_options(model, q0, kControllerRate, 0);
-  const PidOptions delayed = default_pid_options(model, q0, kControllerRate, 1);
+  const PidOptions ff = reference_pid_options(model, q0.transpose(), kControllerRate, 0);
+  const PidOptions delayed = reference_pid_options(model, q0.transpose(), kControllerRate, 1);
   EXPECT_NEAR(ff.kp[0], d1 * w * w / mu_max, 1e-9 * ff.kp[0]);
   EXPECT_NEAR(ff.kp[1], d2 * w * w / mu_max, 1e-9 * ff.kp[1]);
   EXPECT_NEAR(ff.kd[0], ff.kp[0] * 2 * 0.9 / w, 1e-9 * ff.kd[0]);
@@ -151,7 +151,8 @@ TEST(ControllerChoice, RuleBoundsTheCoupledModeAndTheLag) {
   EXPECT_EQ(ff.feed_forward, FeedForward::kComputedTorque);
   // Plain PID: the gravity floor. At q = 0 joint 2 carries g·m2·lc2 (closed form), so
   // kp2 = max(rule, min(g·m2·lc2/0.02, D2·ω²)); joint 1 carries g·(m1·lc1 + m2·(l1 + lc2)).
-  const PidOptions pid = default_pid_options(model, q0, kControllerRate, 0, FeedForward::kNone);
+  const PidOptions pid =
+      reference_pid_options(model, q0.transpose(), kControllerRate, 0, FeedForward::kNone);
   EXPECT_EQ(pid.feed_forward, FeedForward::kNone);
   const double g2 = arm.g * arm.m2 * arm.lc2;
   const double g1 = arm.g * (arm.m1 * arm.lc1 + arm.m2 * (arm.l1 + arm.lc2));
@@ -159,7 +160,7 @@ TEST(ControllerChoice, RuleBoundsTheCoupledModeAndTheLag) {
   EXPECT_NEAR(pid.kp[0], std::max(ff.kp[0], std::min(g1 / 0.02, d1 * w * w)), 1e-9 * pid.kp[0]);
   EXPECT_GT(pid.kp[1], ff.kp[1]);  // the floor is active on this arm
   EXPECT_NE(testing::error_of([&] {
-              default_pid_options(model, q0, kControllerRate, -1);
+              reference_pid_options(model, q0.transpose(), kControllerRate, -1);
             }).find("measurement delay must be >= 0"),
             std::string::npos);
 }

@@ -30,7 +30,12 @@ PidOptions reference_pid_options(const Model& model,
                                  double rate_hz, int delay_samples = 0,
                                  FeedForward feed_forward = FeedForward::kComputedTorque);
 
-/// reference_pid_options() for the single configuration q0 (size n): a robot held at q0.
+/// The earlier single-configuration rule, kept for the demo and the tests whose measured
+/// numbers rely on it (simulate uses reference_pid_options()): kp = M_jj(q0)·ω²/μ, kd =
+/// 2ζ·M_jj(q0)·ω/μ, ki = kp/2, ω as in reference_pid_options(), μ = λ_max(M⁻¹·diag M) at q0 for
+/// a plain PID or a delay and 1 for the delay-free feed-forward loop (whose coupled mode can then
+/// be unstable: planar2 stretched, iiwa14; docs/methods/sim.md). Throws dynid::Error for
+/// rate_hz ≤ 0 or delay_samples < 0.
 PidOptions default_pid_options(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q0,
                                double rate_hz, int delay_samples = 0,
                                FeedForward feed_forward = FeedForward::kComputedTorque);
