@@ -504,7 +504,7 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
       records.push_back(read_joint_record(o.runs[i], model, file, &read));
     }
     progress.update((steps - 1.0) / steps, "filtering and estimating");
-    // The ML iterations fill the last step of the line.
+    // identify()'s stages (preparation, estimate, ML iterations) fill the last step of the line.
     options.progress = [&progress, steps](double fraction, const std::string& what) {
       progress.update((steps - 1.0 + fraction) / steps, what);
     };

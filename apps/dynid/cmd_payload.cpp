@@ -15,6 +15,7 @@
 #include "commands.hpp"
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
+#include "dynid/common/progress.hpp"
 #include "dynid/identification/cutoff_selection.hpp"
 #include "dynid/identification/identify.hpp"
 #include "dynid/identification/validation.hpp"
@@ -48,6 +49,7 @@ struct PayloadCliOptions {
   std::string gravity = "0 0 -9.81";
   double interval = 0.2, wrench_sign = 1.0, confidence = 0.999, cutoff = 0.0;
   bool bias = false, standing = false, no_filter = false;
+  bool quiet = false;  // --quiet
 };
 
 // Columns `names` as an m×k block, or empty when none is present; some but not all is an error.
@@ -209,6 +211,9 @@ void run_payload_from_torques(const PayloadCliOptions& cli, const CLI::App& cmd,
   const bool json_reference =
       cli.reference.size() >= 5 && cli.reference.substr(cli.reference.size() - 5) == ".json";
   if (json_reference) return run_payload_from_result(cli, cmd, options, model, link, frame, file);
+  // The stages on a progress line (payload was silent for 44 s on a long run).
+  ProgressLine progress("payload", progress_wanted(cli.quiet));
+  progress.update(0.0, "reading the runs");
   // Both runs are read alike; the window (--rows, --time) is of the loaded run only.
   RunFileReport read;
   const JointRecord loaded_raw = read_joint_record(cli.data, model, file, &read);
@@ -223,17 +228,21 @@ void run_payload_from_torques(const PayloadCliOptions& cli, const CLI::App& cmd,
   identify.signal.filter = !cli.no_filter;
   identify.signal.cutoff_hz = cli.cutoff;
   identify.signal.torque_time_offset = cli.run.shift();
+  progress.update(0.1, "choosing the cut-off on the reference run");
   const CutoffSelection cutoff = select_cutoff(model, unloaded_raw, identify);
   const SignalOptions signal = cutoff.signal;
   std::vector<std::pair<std::string, std::string>> choices, reference_choices;
+  progress.update(0.6, "filtering both runs");
   const JointRecord loaded = preprocess(loaded_raw, signal, choices).record;
   echo_cutoff_selection(cutoff, choices);
   const JointRecord unloaded = preprocess(unloaded_raw, signal, reference_choices).record;
   // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
   options.hac_covariance = signal.filter;
   options.record_history = false;
+  progress.update(0.8, "estimating the load");
   const LoadIdentificationResult r = identify_load_from_torques(
       model, link, frame, ParameterLayout::full(), loaded, unloaded, options);
+  progress.finish();
   write_torque_result(cli, r, model, link, choices);
 }
 
@@ -299,6 +308,8 @@ void run_payload(const PayloadCliOptions& cli, const CLI::App& cmd) {
                    "the sensor's own offsets are --bias\n";
     }
   }
+  ProgressLine progress("payload", progress_wanted(cli.quiet));
+  progress.update(0.0, "reading the run");
   RunFileReport read;
   const RunFileOptions file = run_file_options(cli.run);
   RunTable run = read_run_table(cli.data, file, read, false);
@@ -354,6 +365,7 @@ void run_payload(const PayloadCliOptions& cli, const CLI::App& cmd) {
       signal.filter = !cli.no_filter;
       signal.cutoff_hz = cli.cutoff;
       // The automatic cut-off by held-out prediction of the wrench, as identify chooses its own.
+      progress.update(0.2, "choosing the cut-off and filtering");
       PreparedLoadRun run =
           prepare_sensor_run(model, mount, record, wrench, signal, equations, choices);
       // Filtering correlates neighbouring residuals: intervals from the HAC sandwich.
@@ -381,8 +393,10 @@ void run_payload(const PayloadCliOptions& cli, const CLI::App& cmd) {
     motion = sensor_motion_from_orientation(log, Eigen::Vector3d(g[0], g[1], g[2]), choices);
     frame = {{"orientation", "qx qy qz qw from the data"}};
   }
+  progress.update(0.8, "estimating the load");
   const EquationBlock block = load_equations(motion, wrench, equations);
   const LoadIdentificationResult r = identify_load(block, options);
+  progress.finish();
   const char* model_name = equations.model == LoadModelKind::kStatic     ? "static"
                            : equations.model == LoadModelKind::kIntegral ? "integral"
                                                                          : "differential";
@@ -448,6 +462,8 @@ void add_payload_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--cutoff", o->cutoff,
                   "With --robot: low-pass cut-off [Hz] for q and the wrench; 0 = automatic");
+  cmd->add_flag("--quiet,-q", o->quiet,
+                "No progress line on stderr (shown only when stderr is a terminal)");
   cmd->add_flag("--no-filter", o->no_filter, "With --robot: do not low-pass q and the wrench");
   add_run_flags(cmd, o->run);
   cmd->add_option("--link", o->link,

@@ -286,3 +286,34 @@ def test_load_model_warns_of_a_vendor_inertia_and_refuses_it_when_strict():
         assert dynid.load_model(path).dof == 2
     with pytest.raises(dynid.Error, match="link 'wrist'"):
         dynid.load_model(path, strict=True)
+
+
+def test_nominal_and_lockstep_facts_of_the_data(planar2):
+    # issue 26 item 5: each base parameter carries the nominal model's value (the NumPy oracle:
+    # theta_1 + K_d theta_2 of the model's own parameters; None where the model has no friction),
+    # and an elbow that follows the shoulder is named as lockstep with what it leaves undetermined.
+    t, q, dq, ddq = fourier_run(4)
+    options = dict(armature=False, viscous=True, coulomb=False, offset=False, filter=False)
+    result = dynid.identify(planar2, t, q, planar2_torques(q, dq, ddq), dq=dq, ddq=ddq, **options)
+    base = dynid.base_parameters(planar2, armature=False, viscous=True, coulomb=False,
+                                 offset=False)
+    theta = np.concatenate([planar2.standard_parameters,
+                            np.zeros(len(base["layout_names"]) - 20)])
+    nominal = theta[base["base_indices"]] + base["K_d"] @ theta[base["dependent_indices"]]
+    for p, x, b in zip(result["parameters"], nominal, base["base_parameters"]):
+        assert p["name"] == b["name"]
+        if p["name"].startswith("Fv"):
+            assert p["nominal"] is None
+        else:
+            assert p["nominal"] == pytest.approx(x, rel=1e-12, abs=1e-12)
+    assert result["lockstep"] == []
+
+    q2 = np.column_stack([q[:, 0], 0.6 * q[:, 0] + 0.2])
+    dq2 = np.column_stack([dq[:, 0], 0.6 * dq[:, 0]])
+    ddq2 = np.column_stack([ddq[:, 0], 0.6 * ddq[:, 0]])
+    locked = dynid.identify(planar2, t, q2, planar2_torques(q2, dq2, ddq2), dq=dq2, ddq=ddq2,
+                            **options)
+    assert len(locked["lockstep"]) == 1
+    assert locked["lockstep"][0]["joints"] == ["shoulder", "elbow"]
+    assert locked["lockstep"][0]["correlation"] == pytest.approx(1.0, abs=1e-9)
+    assert any("move in lockstep" in w for w in locked["warnings"])

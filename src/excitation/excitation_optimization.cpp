@@ -480,6 +480,25 @@ struct Context {
   std::vector<double> grad_x;
   Eigen::VectorXd grad_f;
   Eigen::MatrixXd jac_g;  // constraints × dim
+  // Progress within a start, so that the line moves during the optimisation, not only between
+  // starts (it sat at 25 % for the whole budget when the first of 4 starts used it up).
+  ProgressCallback progress;
+  int start = 0, starts = 1, start_evaluations = 0, max_evaluations = 1;
+  Clock::time_point begin = Clock::now();
+
+  void report_progress() {
+    const double in_start =
+        std::min(1.0, static_cast<double>(evaluations - start_evaluations) / max_evaluations);
+    double fraction = (start + in_start) / starts;
+    if (deadline != Clock::time_point::max()) {
+      const double total = std::chrono::duration<double>(deadline - begin).count();
+      const double spent = std::chrono::duration<double>(Clock::now() - begin).count();
+      if (total > 0.0) fraction = std::max(fraction, spent / total);
+    }
+    progress(std::min(fraction, 0.99), "start " + std::to_string(start + 1) + "/" +
+                                           std::to_string(starts) + ", evaluation " +
+                                           std::to_string(evaluations));
+  }
 
   void compute(const double* x) {
     const int dim = pb->dim;
@@ -488,6 +507,7 @@ struct Context {
     Evaluator::unpack(*pb, x, rest, c);
     ev->run(c);
     ++evaluations;
+    if (progress && evaluations % 20 == 0) report_progress();
     last_x.assign(x, x + dim);
     f = d_optimal ? -ev->log_det : ev->log_cond;
     g = ev->g;
@@ -590,12 +610,18 @@ ExcitationResult optimize_excitation(const Model& model, const ExcitationOptions
       std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.max_time));
   if (options.max_time > 0.0) ctx.deadline = t_begin + budget;
   ev.deadline = ctx.deadline;
+  ctx.progress = options.progress;
+  ctx.starts = options.starts;
+  ctx.max_evaluations = options.max_evaluations;
+  ctx.begin = t_begin;
 
   std::mt19937 rng(options.seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   const int m = ev.constraints();
   int starts_feasible = 0;
   for (int start = 0; start < options.starts; ++start) {
+    ctx.start = start;
+    ctx.start_evaluations = ctx.evaluations;
     if (Clock::now() > ctx.deadline) break;
     // Random start: coefficients uniform in their bounds, q0 near the middle of the range, then
     // the harmonic part scaled down (bisection on the amplitude) until every constraint holds.

@@ -803,6 +803,29 @@ Eigen::VectorXd BaseParameters::reduce(const Eigen::Ref<const Eigen::VectorXd>& 
   return b;
 }
 
+std::vector<std::optional<double>> nominal_base_values(const Model& model,
+                                                       const BaseParameters& base,
+                                                       const ParameterLayout& layout) {
+  const int p = layout.columns(model.dof());
+  const auto columns = static_cast<Eigen::Index>(base.layout_names.size());
+  if (columns < p || static_cast<int>(base.base.size()) != base.rank) {
+    throw Error("nominal_base_values: the base parameters have " + std::to_string(columns) +
+                " columns, the layout of model '" + model.name + "' " + std::to_string(p) +
+                "; compute them for this model and layout");
+  }
+  Eigen::VectorXd theta = Eigen::VectorXd::Zero(columns);
+  theta.head(p) = layout.parameters(model);
+  const Eigen::VectorXd b = base.reduce(theta);
+  const int link_columns = kLinkParams * model.dof();
+  std::vector<std::optional<double>> out(static_cast<size_t>(base.rank));
+  for (int i = 0; i < base.rank; ++i) {
+    const int lead = base.base[static_cast<size_t>(i)];
+    if (lead >= link_columns && theta[lead] == 0.0) continue;
+    out[static_cast<size_t>(i)] = b[i];
+  }
+  return out;
+}
+
 Eigen::MatrixXd BaseParameters::select(const Eigen::Ref<const Eigen::MatrixXd>& W) const {
   Eigen::MatrixXd Wb(W.rows(), rank);
   for (int i = 0; i < rank; ++i) Wb.col(i) = W.col(base[i]);

@@ -24,6 +24,11 @@ namespace dynid {
 
 namespace {
 
+// Shares of identify()'s progress line: the runs' preparation, then the stacked estimate; maximum
+// likelihood (when asked) fills the rest.
+constexpr double kPreparedShare = 0.7;
+constexpr double kEstimateShare = 0.1;
+
 // The joint a layout column belongs to: link parameters of link j and joint columns of joint j;
 // −1 for coupled-motor columns.
 int column_joint(const Model& model, const ParameterLayout& layout, int column) {
@@ -39,6 +44,7 @@ void not_excited_warnings(const Model& model, const ParameterLayout& layout,
                           const BaseParameters& base, const EquationBlock& based,
                           const DataIdentifiability& data,
                           const std::vector<std::string>& expressions,
+                          const std::vector<LockstepJoints>& lockstep,
                           std::vector<std::string>& warnings) {
   std::ostringstream head;
   head << std::setprecision(3) << "the data excite " << data.rank << " of the model's " << base.rank
@@ -84,7 +90,13 @@ void not_excited_warnings(const Model& model, const ParameterLayout& layout,
         << (with.empty() ? "the other parameters" : with)
         << " (those estimates include its effect on these runs)";
     }
-    if (joint >= 0) {
+    const auto pair = std::find_if(lockstep.begin(), lockstep.end(), [&](const auto& p) {
+      return p.first == joint || p.second == joint;
+    });
+    if (pair != lockstep.end()) {
+      // The joint moved; "a run in which it moves" would be wrong advice (issue 26 item 5).
+      w << "; " << lockstep_text(model, *pair);
+    } else if (joint >= 0) {
       w << "; a run in which " << model.joints[static_cast<size_t>(joint)].name
         << " moves (above its encoder noise, with both velocity signs and varied "
            "configurations of the joints before it) would "
@@ -168,8 +180,19 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
   // prepare + equations, one run at a time (each its own rate, filter edges, derivatives).
   std::vector<EquationBlock> blocks;
   std::vector<ScreenedRun> screened;
+  std::vector<Eigen::MatrixXd> velocities;  // per run, as processed (lockstep diagnosis)
   result.zero_velocity_threshold = Eigen::VectorXd::Zero(n);
+  // The progress line advances through the real stages (it sat at 0 % for 17 s): each run's
+  // preparation (the cut-off selection is most of it) takes kPreparedShare, the stacked estimate
+  // the next share, maximum likelihood the rest.
+  const auto stage = [&](double fraction, const std::string& what) {
+    if (options.progress) options.progress(fraction, what);
+  };
+  const double runs_count = static_cast<double>(runs.size());
   for (size_t i = 0; i < runs.size(); ++i) {
+    stage(kPreparedShare * static_cast<double>(i) / runs_count,
+          "run " + std::to_string(i + 1) + "/" + std::to_string(runs.size()) +
+              ": screening, cut-off, filtering");
     std::vector<std::pair<std::string, std::string>> choices;
     screened.push_back(screen_run(model, runs[i], options.outliers));  // outliers.hpp
     ProcessedRecord processed;
@@ -234,11 +257,13 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
     const std::string prefix = runs.size() > 1 ? "run " + std::to_string(i + 1) + " " : "";
     for (auto& [key, value] : choices) result.choices.emplace_back(prefix + key, value);
     if (ml) prepared.push_back(processed);
+    velocities.push_back(processed.record.dq);
     if (i == 0) result.processed = std::move(processed);
     result.warnings.insert(result.warnings.end(), screened.back().warnings.begin(),
                            screened.back().warnings.end());
   }
   // stack + structural base columns (Gautier–Khalil, from the model).
+  stage(kPreparedShare, "base parameters and what the data determine");
   BaseParameterOptions base_options = options.base;
   base_options.layout = options.layout;
   base_options.coupling = coupling;
@@ -296,10 +321,28 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
       result.expressions[i] += term.str();
     }
   }
+  // Joints in lockstep, and the not excited parameters of theirs that this explains.
+  result.lockstep = find_lockstep_joints(velocities);
+  for (LockstepJoints& pair : result.lockstep) {
+    for (int c : data.not_excited) {
+      const int joint =
+          column_joint(model, options.layout, result.base.base[static_cast<size_t>(c)]);
+      if (joint == pair.first || joint == pair.second)
+        pair.undetermined.push_back(result.base.names[static_cast<size_t>(c)]);
+    }
+  }
   if (deficient)
     not_excited_warnings(model, options.layout, result.base, based, data, result.expressions,
-                         result.warnings);
+                         result.lockstep, result.warnings);
+  {
+    const std::vector<std::optional<double>> nominal =
+        nominal_base_values(model, result.base, options.layout);
+    for (int c : data.kept) result.nominal.push_back(nominal[static_cast<size_t>(c)]);
+  }
   // estimate
+  stage(kPreparedShare + 0.5 * kEstimateShare, "estimating " + std::to_string(W.W.cols()) +
+                                                   " parameters from " +
+                                                   std::to_string(W.y.size()) + " equations");
   BlockEstimationOptions eo;
   eo.estimator = options.estimator;
   eo.confidence_level = options.confidence_level;
@@ -345,7 +388,15 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
     projected.dimensions = projected_dimensions;
     std::vector<int> columns;
     for (int c : data.kept) columns.push_back(result.base.base[static_cast<size_t>(c)]);
-    maximum_likelihood_stage(model, options, coupling, blocks, prepared, screened.front().record,
+    IdentifyOptions ml_options = options;
+    if (options.progress) {
+      ml_options.progress = [&options](double fraction, const std::string& what) {
+        options.progress(
+            kPreparedShare + kEstimateShare + (1.0 - kPreparedShare - kEstimateShare) * fraction,
+            what);
+      };
+    }
+    maximum_likelihood_stage(model, ml_options, coupling, blocks, prepared, screened.front().record,
                              columns, W, projected, fit, result.choices);
   }
   check_finite_estimate(fit.estimate, screened.front());
@@ -377,6 +428,21 @@ IdentificationResult identify(const Model& model, const std::vector<JointRecord>
   }
   result.warnings.insert(result.warnings.end(), result.estimate.summary.warnings.begin(),
                          result.estimate.summary.warnings.end());
+  // A pair whose parameters were all estimated: name those the estimate leaves at more than
+  // 100 % relative std (not even the order of magnitude determined).
+  for (LockstepJoints& pair : result.lockstep) {
+    if (pair.undetermined.empty()) {
+      for (size_t i = 0; i < data.kept.size(); ++i) {
+        const int c = data.kept[i];
+        const int joint =
+            column_joint(model, options.layout, result.base.base[static_cast<size_t>(c)]);
+        if ((joint == pair.first || joint == pair.second) &&
+            !(result.estimate.relative_std_percent[static_cast<Eigen::Index>(i)] <= 100.0))
+          pair.undetermined.push_back(result.names[i]);
+      }
+    }
+    result.warnings.push_back(lockstep_text(model, pair));
+  }
   return result;
 }
 

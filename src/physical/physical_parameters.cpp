@@ -394,8 +394,16 @@ PhysicalCheck physical_parameters_of_result(const Model& model, const Identifica
         "not excited by the data, so set by the consistent model nearest the nominal one: " + [&] {
           std::string list;
           for (const auto& name : result.not_excited) list += (list.empty() ? "" : ", ") + name;
+          // Why they are not excited, when the joints moved but together (issue 26 item 5).
+          for (const LockstepJoints& pair : result.lockstep)
+            list += "; " + lockstep_text(model, pair);
           return list;
         }());
+  } else {
+    for (const LockstepJoints& pair : result.lockstep)
+      out.warnings.push_back(lockstep_text(model, pair) +
+                             "; until then the consistent set keeps the nominal model's values "
+                             "where the data leave freedom");
   }
   out.fit = physical_parameters(model, result.base, options.layout, result.estimate.x,
                                 result.estimate.covariance, {}, observed);

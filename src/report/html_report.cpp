@@ -129,6 +129,7 @@ void add_parameters(const Json& result, Json& section) {
   if (params.empty()) return;
   Json labels = Json::array(), low = Json::array(), high = Json::array(), value = Json::array(),
        colors = Json::array(), tips = Json::array(), rows = Json::array();
+  bool nominal = false;
   for (const auto& p : params) {
     if (!p.is_object()) continue;
     const std::string name = text_of(p.value("name", Json("?")));
@@ -149,6 +150,17 @@ void add_parameters(const Json& result, Json& section) {
     rows.push_back({name, text_of(p.value("value", Json())), text_of(p.value("std", Json())),
                     text_of(p.value("relative_std_percent", Json())),
                     text_of(p.value("ci_low", Json())), text_of(p.value("ci_high", Json()))});
+    // The nominal model's value beside the estimate (identify results; n/a where it has none).
+    if (p.contains("nominal")) {
+      nominal = true;
+      rows.back().push_back(text_of(p["nominal"]));
+    }
+  }
+  Json columns = {"name", "value", "std", "%σ", "ci low", "ci high"};
+  if (nominal) {
+    columns.push_back("nominal");
+    for (auto& row : rows)
+      if (row.size() < columns.size()) row.push_back("n/a");
   }
   std::string level = "confidence";
   if (result.contains("confidence_level") && result["confidence_level"].is_number()) {
@@ -166,9 +178,7 @@ void add_parameters(const Json& result, Json& section) {
                                {"colors", colors},
                                {"tips", tips},
                                {"wide", true}});
-  section["tables"].push_back({{"title", "Parameters"},
-                               {"columns", {"name", "value", "std", "%σ", "ci low", "ci high"}},
-                               {"rows", rows}});
+  section["tables"].push_back({{"title", "Parameters"}, {"columns", columns}, {"rows", rows}});
 }
 
 // Per-joint bar chart of one array of the result (residual RMS, relative error).

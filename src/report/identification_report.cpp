@@ -95,6 +95,9 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
     // A data regrouping's name (Fc2R) is what the user reads; the base parameter it extends is
     // what validate, export and the completion look up.
     if (reported_name(r, i) != r.names[i]) params.back()["base_name"] = r.names[i];
+    // The nominal (model file's) value beside the estimate; null where the model has none.
+    params.back()["nominal"] =
+        i < r.nominal.size() && r.nominal[i] ? json_number(*r.nominal[i]) : nlohmann::json(nullptr);
     if (e.std_dev_white.size() == e.x.size()) {
       params.back()["std_white"] = json_number(e.std_dev_white[k]);
       params.back()["ci_white_low"] = json_number(e.ci_lower_white[k]);
@@ -103,6 +106,14 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
   }
   nlohmann::json choices = nlohmann::json::object();
   for (const auto& [k, v] : r.choices) choices[k] = v;
+  nlohmann::json lockstep = nlohmann::json::array();
+  for (const LockstepJoints& pair : r.lockstep) {
+    lockstep.push_back({{"joints",
+                         {model.joints[static_cast<size_t>(pair.first)].name,
+                          model.joints[static_cast<size_t>(pair.second)].name}},
+                        {"correlation", json_number(pair.correlation)},
+                        {"undetermined", pair.undetermined}});
+  }
   nlohmann::json runs = nlohmann::json::array();
   for (const auto& run : r.runs) {
     runs.push_back({{"file", run.file},
@@ -144,6 +155,7 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
                         {"data_rank", r.data_rank},
                         {"not_excited", r.not_excited},
                         {"data_regrouped", r.data_regrouped},
+                        {"lockstep", lockstep},
                         {"runs", runs},
                         {"excitation", excitation},
                         {"condition_number", json_number(r.condition_number)},
@@ -172,12 +184,15 @@ std::string identification_table(const Model& model, const IdentificationResult&
   int pw = 10;
   for (size_t i = 0; i < r.names.size(); ++i)
     pw = std::max(pw, static_cast<int>(reported_name(r, i).size()));
-  s << line("%-*s %14s %12s %9s   %-29s\n", pw, "parameter", "value", "std", "%std",
+  s << line("%-*s %14s %12s %9s %14s   %-29s\n", pw, "parameter", "value", "std", "%std", "nominal",
             (line("%.4g", 100 * e.confidence_level) + "% confidence interval").c_str());
   for (size_t i = 0; i < r.names.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
-    s << line("%-*s %14.6g %12.4g %9.2f   [%.6g, %.6g]\n", pw, reported_name(r, i).c_str(), e.x[k],
-              e.std_dev[k], e.relative_std_percent[k], e.ci_lower[k], e.ci_upper[k]);
+    const std::string nominal =
+        i < r.nominal.size() && r.nominal[i] ? line("%.6g", *r.nominal[i]) : "-";
+    s << line("%-*s %14.6g %12.4g %9.2f %14s   [%.6g, %.6g]\n", pw, reported_name(r, i).c_str(),
+              e.x[k], e.std_dev[k], e.relative_std_percent[k], nominal.c_str(), e.ci_lower[k],
+              e.ci_upper[k]);
   }
   s << line(
       "\nrank %d, condition number %.4g, %ld samples, %ld equations, relative error %.2f %%\n",

@@ -76,11 +76,17 @@ std::vector<std::string> check_run_plausibility(const Eigen::Ref<const Eigen::Ve
   const Eigen::Index m = t.size();
   if (auto w = check_sample_rate(t, options)) warnings.push_back(std::move(*w));
   if (m == 0 || q.cols() == 0) return warnings;
-  std::vector<std::string> zero_torque, still;
+  std::vector<std::string> zero_torque, still, mostly_zero;
   for (Eigen::Index j = 0; j < tau.cols(); ++j) {
     const std::string name =
         j < static_cast<Eigen::Index>(joints.size()) ? joints[j] : "joint " + std::to_string(j + 1);
-    if (tau.col(j).cwiseAbs().maxCoeff() == 0.0) zero_torque.push_back(name);
+    const auto zeros = (tau.col(j).array() == 0.0).count();
+    if (zeros == tau.rows()) {
+      zero_torque.push_back(name);
+    } else if (static_cast<double>(zeros) > options.unlogged_zero_fraction * tau.rows()) {
+      mostly_zero.push_back(name + " (" +
+                            short_number(100.0 * static_cast<double>(zeros) / tau.rows()) + " %)");
+    }
     if (q.col(j).maxCoeff() - q.col(j).minCoeff() < options.still_range) still.push_back(name);
   }
   if (static_cast<Eigen::Index>(zero_torque.size()) == tau.cols()) {
@@ -96,6 +102,13 @@ std::vector<std::string> check_run_plausibility(const Eigen::Ref<const Eigen::Ve
   if (!zero_torque.empty()) {
     warnings.push_back("torque zero in every sample for " + join(zero_torque) +
                        ": their parameters cannot be identified; check those tau columns");
+  }
+  if (!mostly_zero.empty()) {
+    warnings.push_back("torque exactly zero in most samples for " + join(mostly_zero) +
+                       ": a measured torque is rarely exactly 0, so those channels were not "
+                       "logged or only part of the time; their rows pull the parameters towards "
+                       "zero torque: check those tau columns, or keep only the logged rows "
+                       "(--rows, --time)");
   }
   if (!still.empty()) {
     warnings.push_back(join(still) + " do not move (position range below " +

@@ -20,7 +20,7 @@
 namespace {
 
 namespace fs = std::filesystem;
-using CliRun = dynid::testing::CliResult;
+using JointLockRun = dynid::testing::CliResult;
 
 const std::string kModels = std::string(DYNID_SOURCE_DIR) + "/tests/data/models/";
 const std::string kRobot = kModels + "planar2_gripper.yaml";
@@ -130,7 +130,7 @@ class JointLockCli : public dynid::testing::CliScratchTest {
 // joints it lacks are held at 0 and said; --lock holds them elsewhere, with numbered columns too.
 TEST_F(JointLockCli, InverseDynamicsHoldsTheJointsTheLogLacks) {
   const std::string named = write_run("named.csv", {}, true, false);
-  CliRun r =
+  JointLockRun r =
       run("inverse-dynamics --robot " + kRobot + " --in " + named + " --out " + path("tau0.csv"));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("inverse-dynamics: locked joints (not in '" + named +
@@ -159,7 +159,7 @@ TEST_F(JointLockCli, IdentifyRecoversTheHeldArmAndLaterCommandsReuseTheLocks) {
   const dynid::testing::Planar2 arm = locked_arm(finger, pan);
   const std::string data = write_run("run.csv", arm, false, true);
   const std::string result = path("result.json");
-  CliRun r = run("identify --robot " + kRobot + " --data " + data + " --out " + result +
+  JointLockRun r = run("identify --robot " + kRobot + " --data " + data + " --out " + result +
                  " --joints shoulder,elbow --lock finger=0.05,camera_pan=3.141592653589793 "
                  "--friction none --no-armature --filter none --physical");
   ASSERT_EQ(r.code, 0) << r.err;
@@ -227,11 +227,11 @@ TEST_F(JointLockCli, IdentifyRecoversTheHeldArmAndLaterCommandsReuseTheLocks) {
 
 // Item 1: the flags are one definition on every command that takes --robot.
 TEST_F(JointLockCli, EveryRobotCommandTakesTheSameRobotFlags) {
-  const CliRun reference = run("identify --help");
+  const JointLockRun reference = run("identify --help");
   ASSERT_EQ(reference.code, 0);
   for (const char* command : {"identify", "validate", "payload", "inverse-dynamics", "excite",
                               "simulate", "export", "model", "compare-control"}) {
-    const CliRun help = run(std::string(command) + " --help");
+    const JointLockRun help = run(std::string(command) + " --help");
     ASSERT_EQ(help.code, 0) << command;
     for (const char* flag : {"--joints", "--lock", "--strict"}) {
       const auto own = reference.out.find(std::string(flag) + " ");
@@ -266,7 +266,7 @@ TEST_F(JointLockCli, VendorUrdfsLoadAndXacroLeftoversAreNamed) {
     return run("inverse-dynamics --robot " + kModels + urdf + " --in " + numbered + " --out " +
                path(out));
   };
-  CliRun r = id("vendor_triangle.urdf", "vendor.csv");
+  JointLockRun r = id("vendor_triangle.urdf", "vendor.csv");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err.rfind("warning: link 'wrist' has a non-physical inertia", 0), 0u) << r.err;
   EXPECT_NE(r.err.find("by 2.913 %"), std::string::npos) << r.err;

@@ -64,9 +64,11 @@ struct ExcitationOptions {
   double grid_margin = 0.03;
   double workspace_margin = 0.01;  ///< same for the workspace planes, in metres [m]
 
-  int starts = 4;              ///< multi-start: number of random initial points
-  unsigned seed = 20261123;    ///< seed of the random initial points (deterministic runs)
-  ProgressCallback progress;   ///< called after each start (common/progress.hpp); may be empty
+  int starts = 4;            ///< multi-start: number of random initial points
+  unsigned seed = 20261123;  ///< seed of the random initial points (deterministic runs)
+  ProgressCallback
+      progress;  ///< every 20 evaluations and after each start (common/progress.hpp): the
+                 ///< larger of the evaluations and the time budget spent; may be empty
   int max_evaluations = 3000;  ///< evaluation budget per start
   double max_time = 10.0;      ///< wall-clock budget of base parameters + all starts [s]; 0 = none
                                ///< (the final fine-grid check gets one more max_time at most)

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -80,6 +81,16 @@ struct BaseParameters {
 /// 2 GB.
 BaseParameters compute_base_parameters(const Model& model,
                                        const BaseParameterOptions& options = {});
+
+/// The nominal model's value of every base parameter: θ_b⁰ = θ_1⁰ + K_d·θ_2⁰ (Gautier–Khalil), θ⁰
+/// the model's own standard parameters in `layout` (ParameterLayout::parameters(), coupled-motor
+/// columns 0), in base.names order and units. A base parameter led by a per-joint column (Ia, Fv,
+/// Fc, Fo, a coupled motor's Coulomb) whose model value is 0 has no nominal value (std::nullopt):
+/// a URDF has no field for rotor inertia or offsets, and an absent <dynamics> is no friction
+/// estimate. Throws dynid::Error when `base` was not computed for `model` with `layout`.
+std::vector<std::optional<double>> nominal_base_values(const Model& model,
+                                                       const BaseParameters& base,
+                                                       const ParameterLayout& layout);
 
 /// Classifies the columns of a given sampled regressor W (rows = equations) the same way; used by
 /// compute_base_parameters and by the identification on real data to report unexcited columns.

@@ -3,6 +3,7 @@
 // identify(): the pipeline of docs/design.md §8 over one or several runs (prepare → equations →
 // stack → estimate), its options and its result.
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "dynid/common/progress.hpp"
 #include "dynid/estimation/estimate.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
+#include "dynid/identification/data_diagnostics.hpp"
 #include "dynid/identification/integral_options.hpp"
 #include "dynid/identification/known_friction.hpp"
 #include "dynid/identification/outlier_options.hpp"
@@ -82,14 +84,20 @@ struct IdentificationResult {
   /// names[i] stays the identifier every lookup in base.names uses. Empty = names.
   std::vector<std::string> labels;
   std::vector<std::string> unidentifiable;  ///< standard parameters with no effect at all
-  Estimate estimate;                        ///< values, σ, %σ, CI, residual statistics, summary
-  int rank = 0;                             ///< base parameters (model rank)
-  double condition_number = 0.0;            ///< of the (weighted) base regressor on these data
-  Eigen::Index samples = 0;                 ///< samples used after processing
-  Eigen::Index rows = 0;                    ///< equations used (after zero-velocity removal)
-  Eigen::VectorXd residual_rms;             ///< per joint [N·m]
-  Eigen::VectorXd joint_relative_error;     ///< per joint ‖e_j‖/‖tau_j‖
-  double relative_error = 0.0;              ///< ‖tau − Ŷθ̂‖/‖tau‖ over the rows used
+  /// Per name, the nominal model's value of that base parameter (nominal_base_values()); empty
+  /// where the model has none (a per-joint term the model gives as 0, e.g. friction of a URDF).
+  std::vector<std::optional<double>> nominal;
+  /// Joints whose velocities move together in every run (find_lockstep_joints()), with the base
+  /// parameters that leaves undetermined; each is also a warning.
+  std::vector<LockstepJoints> lockstep;
+  Estimate estimate;                     ///< values, σ, %σ, CI, residual statistics, summary
+  int rank = 0;                          ///< base parameters (model rank)
+  double condition_number = 0.0;         ///< of the (weighted) base regressor on these data
+  Eigen::Index samples = 0;              ///< samples used after processing
+  Eigen::Index rows = 0;                 ///< equations used (after zero-velocity removal)
+  Eigen::VectorXd residual_rms;          ///< per joint [N·m]
+  Eigen::VectorXd joint_relative_error;  ///< per joint ‖e_j‖/‖tau_j‖
+  double relative_error = 0.0;           ///< ‖tau − Ŷθ̂‖/‖tau‖ over the rows used
   /// Per joint, lag-1 autocorrelation of the residuals over consecutive samples used (in-memory
   /// identify only; a named warning above 0.5: the intervals assume white residuals).
   Eigen::VectorXd residual_autocorrelation;

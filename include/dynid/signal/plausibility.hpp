@@ -14,6 +14,10 @@ struct PlausibilityOptions {
   double max_rate_hz = 100e3;  ///< above: time stamps are not in seconds (e.g. minutes) — error
   double low_rate_hz = 20.0;   ///< below (but ≥ min): accelerations are unreliable — warning
   double still_range = 1e-4;   ///< a joint whose position range is below this does not move
+  /// A torque column exactly 0 in more than this fraction of the samples was not logged (or only
+  /// part of the time): a measured torque, current × constant with noise, is exactly 0 only
+  /// inside half a quantisation step around zero — warning.
+  double unlogged_zero_fraction = 0.5;
 };
 
 /// The time-units diagnosis of a run (identify through check_run_plausibility(), validate
@@ -29,7 +33,8 @@ std::optional<std::string> check_sample_rate(const Eigen::Ref<const Eigen::Vecto
 /// joint moves. t: m strictly increasing time stamps [s]; q, tau: m × n [rad or m, N·m or N];
 /// `joints`: n names for the messages. Throws dynid::Error naming the fault and the fix for the
 /// run as a whole; returns named warnings (one line each) for single joints: torque zero in every
-/// sample, position range below still_range, and a rate below low_rate_hz.
+/// sample, torque exactly zero in more than unlogged_zero_fraction of the samples, position range
+/// below still_range, and a rate below low_rate_hz.
 std::vector<std::string> check_run_plausibility(const Eigen::Ref<const Eigen::VectorXd>& t,
                                                 const Eigen::Ref<const Eigen::MatrixXd>& q,
                                                 const Eigen::Ref<const Eigen::MatrixXd>& tau,
