@@ -87,13 +87,11 @@ ControlComparison compare_control(const Model& plant_model, const Model& control
   }
   SimulateOptions so = options.simulate;
   so.loop.record_truth = true;
-  so.controller_model.reset();
-  // One set of gains for both: the comparison is then about the model, not the tuning. They are
-  // the rule's for the computed-torque law (no gravity stiffness floor: its model supplies
-  // gravity, and the floor's stiffness divided by D would push its loop beyond the bandwidth).
-  so.feed_forward = FeedForward::kInverseDynamics;
-  const PidOptions pid = simulation_pid_options(plant_model, q, info.rate_hz(), so);
   so.feed_forward = FeedForward::kNone;
+  so.controller_model.reset();
+  // One set of gains for both: the comparison is then about the model, not the tuning.
+  const PidOptions pid =
+      simulation_pid_options(plant_model, q.row(0).transpose(), info.rate_hz(), so);
   ControlComparison out;
   out.gains = {pid.kp, pid.ki, pid.kd, "pid"};
   so.gains = out.gains;

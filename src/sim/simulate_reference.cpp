@@ -12,7 +12,6 @@
 #include "dynid/common/message.hpp"
 
 #include "dynid/dynamics/mass_matrix.hpp"
-#include "dynid/dynamics/rnea.hpp"
 #include "dynid/signal/sampling_check.hpp"
 
 namespace dynid {
@@ -24,107 +23,25 @@ namespace {
 // the measurement delay, so the delay-free loops are unchanged and delayed ones stay stable.
 constexpr double kLoopLagBudget = 2 * M_PI * 3.0 / 40.0;
 
-// Configurations of the reference the gain rule reads M(q) and g(q) at (evenly spaced samples):
-// enough to meet the extremes of a few-harmonic trajectory, cheap beside the simulation.
-constexpr Eigen::Index kGainConfigurations = 64;
+}  // namespace
 
-// Position error [rad or m] a light joint's proportional gain alone may leave under its largest
-// gravity torque along the reference (the integral removes it within kp/ki = 2 s).
-constexpr double kGravityErrorBudget = 0.02;
-
-// Checks rate and delay, sets the sample time and derivative filter of `o`, and returns the loop's
-// bandwidth ω [rad/s]: well below the sample rate (rate/40) and below the inverse of its lag, with
-// a derivative filter of at least two samples.
-double loop_timing(double rate_hz, int delay_samples, PidOptions& o) {
+PidOptions default_pid_options(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q0,
+                               double rate_hz, int delay_samples, FeedForward feed_forward) {
   if (!(rate_hz > 0.0) || !std::isfinite(rate_hz))
     throw Error("controller rate must be finite and > 0 Hz, got " + short_number(rate_hz));
   if (delay_samples < 0)
     throw Error("measurement delay must be >= 0 samples, got " + std::to_string(delay_samples));
-  o.sample_time = 1.0 / rate_hz;
-  o.derivative_filter_time = std::max(o.derivative_filter_time, 2.0 / rate_hz);
-  const double lag = (delay_samples + 1) * o.sample_time + o.derivative_filter_time;
-  double w = 2 * M_PI * std::min(8.0, rate_hz / 40.0);
-  if (delay_samples > 0) w = std::min(w, kLoopLagBudget / lag);  // inactive without delay
-  return w;
-}
-
-}  // namespace
-
-PidOptions reference_pid_options(const Model& model,
-                                 const Eigen::Ref<const Eigen::MatrixXd>& q_reference,
-                                 double rate_hz, int delay_samples, FeedForward feed_forward) {
-  const int n = model.dof();
-  if (q_reference.cols() != n || q_reference.rows() < 1 || !q_reference.allFinite())
-    throw Error("controller gains: the reference must be finite, samples x " + std::to_string(n) +
-                " joints, got " + std::to_string(q_reference.rows()) + " x " +
-                std::to_string(q_reference.cols()));
-  PidOptions o;
-  const double w = loop_timing(rate_hz, delay_samples, o);
-  // The configurations the loop will meet: M(q) and g(q) vary along the reference (iiwa14's
-  // joint 1 inertia tenfold), so q0 alone does not represent them.
-  const Eigen::Index m = q_reference.rows();
-  const Eigen::Index count = std::min<Eigen::Index>(m, kGainConfigurations);
-  Workspace ws(model);
-  Eigen::MatrixXd M(n, n);
-  std::vector<Eigen::MatrixXd> inverses;
-  Eigen::VectorXd inertia = Eigen::VectorXd::Constant(n, INFINITY);
-  Eigen::VectorXd gravity_peak = Eigen::VectorXd::Zero(n), g(n);
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
-  RneaOptions gravity_only;
-  gravity_only.joint_terms = false;
-  for (Eigen::Index i = 0; i < count; ++i) {
-    const Eigen::Index k = count > 1 ? i * (m - 1) / (count - 1) : 0;
-    const Eigen::VectorXd q = q_reference.row(k).transpose();
-    mass_matrix(model, ws, q, M);
-    inverses.push_back(M.ldlt().solve(Eigen::MatrixXd::Identity(n, n)));
-    // The "free" inertia 1/(M⁻¹)_jj: what joint j's torque accelerates when the other joints
-    // yield. Unlike M_jj it counts the coupling, so the modes below spread by a factor μ of at
-    // most a few (iiwa14: 2.4 against 10.8 for M_jj).
-    inertia = inertia.cwiseMin(inverses.back().diagonal().cwiseInverse());
-    rnea(model, ws, q, zero, zero, g, gravity_only);
-    gravity_peak = gravity_peak.cwiseMax(g.cwiseAbs());
-  }
-  if (!inertia.allFinite() || !(inertia.minCoeff() > 0.0))
-    throw Error("controller gains: the model of '" + model.name +
-                "' gives a joint no inertia along the reference; give every moving link a mass "
-                "and inertia, or gains with --gains FILE");
-  // Gains kp = D·ω² place the modes of M(q)·ë = −K·e at ω·√μ, μ the eigenvalues of
-  // D^½·M(q)⁻¹·D^½; dividing by the largest μ over the reference keeps every mode at or below ω
-  // in every configuration the loop meets (a coupled fast mode made planar2 chatter and iiwa14
-  // diverge, docs/methods/sim.md).
-  const Eigen::VectorXd d_sqrt = inertia.cwiseSqrt();
-  double mu_max = 1.0;
-  for (const Eigen::MatrixXd& inverse : inverses) {
-    const Eigen::MatrixXd scaled = d_sqrt.asDiagonal() * inverse * d_sqrt.asDiagonal();
-    mu_max = std::max(mu_max, Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(
-                                  0.5 * (scaled + scaled.transpose()), Eigen::EigenvaluesOnly)
-                                  .eigenvalues()
-                                  .maxCoeff());
-  }
-  o.kp = inertia * (w * w / mu_max);
-  // Stiffness floor: a light joint (a wrist without rotor inertia) must still hold the gravity
-  // torque it carries with an error below kGravityErrorBudget while the integral catches up;
-  // never beyond D_j·ω², the joint's own mode at the discrete loop's limit ω.
-  // Only without feed-forward: the feed-forward and computed-torque laws supply gravity.
-  if (feed_forward == FeedForward::kNone) {
-    for (int j = 0; j < n; ++j)
-      o.kp[j] =
-          std::max(o.kp[j], std::min(gravity_peak[j] / kGravityErrorBudget, inertia[j] * w * w));
-  }
-  o.kd = o.kp * (2 * 0.9 / w);  // damping ratio 0.9 at the mode ω
-  o.ki = o.kp * 0.5;
-  o.feed_forward = feed_forward;
-  o.effort_limit = Eigen::VectorXd::Constant(n, 1e6);
-  return o;
-}
-
-PidOptions default_pid_options(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q0,
-                               double rate_hz, int delay_samples, FeedForward feed_forward) {
   Workspace ws(model);
   Eigen::MatrixXd M(model.dof(), model.dof());
   mass_matrix(model, ws, q0, M);
   PidOptions o;
-  const double w = loop_timing(rate_hz, delay_samples, o);
+  o.sample_time = 1.0 / rate_hz;
+  o.derivative_filter_time = std::max(o.derivative_filter_time, 2.0 / rate_hz);
+  // A discrete loop needs its bandwidth well below the sample rate (rate/40) and below the
+  // inverse of its lag; a derivative filter of at least two samples.
+  const double lag = (delay_samples + 1) * o.sample_time + o.derivative_filter_time;
+  double w = 2 * M_PI * std::min(8.0, rate_hz / 40.0);
+  if (delay_samples > 0) w = std::min(w, kLoopLagBudget / lag);  // inactive without delay
   // Gains per joint ∝ M_jj place the modes of M·ë = −K·e at ω·sqrt(μ), μ the eigenvalues of
   // M⁻¹·diag(M) ≥ 1 on average; coupling (planar2's elbow, a 7-joint arm's light wrist) makes
   // μ_max ≫ 1, a fast mode a delayed or feedback-only loop cannot hold. Dividing by μ_max keeps
@@ -148,11 +65,10 @@ PidOptions default_pid_options(const Model& model, const Eigen::Ref<const Eigen:
   return o;
 }
 
-PidOptions simulation_pid_options(const Model& model,
-                                  const Eigen::Ref<const Eigen::MatrixXd>& q_reference,
+PidOptions simulation_pid_options(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q0,
                                   double rate_hz, const SimulateOptions& options) {
-  PidOptions o = reference_pid_options(model, q_reference, rate_hz, options.sensors.position_delay,
-                                       options.feed_forward);
+  PidOptions o =
+      default_pid_options(model, q0, rate_hz, options.sensors.position_delay, options.feed_forward);
   if (options.gains.kp.size() > 0) {
     o.kp = options.gains.kp;
     o.ki = options.gains.ki;
@@ -247,91 +163,6 @@ void check_simulated_run(const Model& model, const ClosedLoopResult& r, const Re
   }
 }
 
-// The largest |q − qr| a run may keep after its first period, per joint: kTrackingFraction of the
-// reference's robust span plus kTrackingFloor (a joint the reference barely moves), plus the
-// sensors' own error. A bounded loop beyond it does not track: its run is not the excitation that
-// was designed, and identification on it would read a different trajectory.
-constexpr double kTrackingFraction = 0.25;
-constexpr double kTrackingFloor = 0.02;  // [rad or m]
-
-// Throws dynid::Error when the run is bounded but does not track (error above the bound above) or
-// its torque chatters: a swing, a sample-to-sample change that reverses at the next sample with
-// both changes above half the torque's robust range (a smooth torque sampled 40 times per loop
-// period changes by about 2π/40 of its range per sample, and reverses only at its extremes) plus
-// what the sensors' noise explains (torque noise directly; position noise and encoder counts
-// through kp and kd/(Tf + Ts)) and the PID's answer to the reference's own steps. A mode near the
-// sample rate makes the first, the second a loop too soft or too slow for the arm.
-void check_tracking(const Model& model, const ClosedLoopResult& r, const Reference& ref,
-                    const SensorOptions& sensors, const PidOptions& pid,
-                    const std::string& gains_fix) {
-  const Eigen::Index period = ref.t.size(), total = r.t.size();
-  const int d = sensors.position_delay;
-  const Eigen::Index from = total > period ? period : std::min<Eigen::Index>(d, total);
-  for (Eigen::Index j = 0; j < r.q.cols(); ++j) {
-    const bool prismatic = model.joints[j].type == JointType::kPrismatic;
-    const double count =
-        prismatic ? sensors.prismatic_resolution
-                  : (sensors.counts_per_rev > 0.0 ? 2 * M_PI / sensors.counts_per_rev : 0.0);
-    const double sensing = 6.0 * sensors.position_noise_std + count;
-    const Band band = robust_band(ref.q.col(j));
-    const double bound = kTrackingFraction * (band.hi - band.lo) + kTrackingFloor + sensing;
-    double worst = 0.0;
-    Eigen::Index at = from;
-    for (Eigen::Index k = std::max<Eigen::Index>(from, d); k < total; ++k) {
-      // The sensor delays the reading by d samples: compare with the reference of then.
-      const double e = std::abs(r.q(k, j) - ref.q((k - d) % period, j));
-      if (e > worst) {
-        worst = e;
-        at = k;
-      }
-    }
-    if (worst > bound) {
-      throw Error("simulate: the closed loop does not track the reference: joint " +
-                  model.joints[j].name + " is " + short_number(worst) + " away from it at t = " +
-                  short_number(r.t[at]) + " s, beyond the bound " + short_number(bound) +
-                  " (a quarter of the reference's span + " + short_number(kTrackingFloor) +
-                  " + the sensor error); the run is not the trajectory designed" + gains_fix);
-    }
-    if (total < 3) continue;
-    const Band torque = robust_band(r.tau.col(j));
-    const double noise =
-        6.0 * std::sqrt(6.0) * sensors.torque_noise_std +
-        4.0 * (pid.kp[j] + 2.0 * pid.kd[j] / (pid.derivative_filter_time + pid.sample_time)) *
-            sensing;
-    // The PID's own answer to a rough reference (a step in qr kicks kp·step at once).
-    // Cyclic: the reference restarts after each period.
-    double rough = 0.0;
-    const auto second_difference = [&](const Eigen::MatrixXd& x, Eigen::Index k) {
-      return std::abs(x((k + 1) % period, j) - 2 * x(k, j) + x((k + period - 1) % period, j));
-    };
-    for (Eigen::Index k = 0; k < period && period >= 3; ++k) {
-      rough = std::max(rough, pid.kp[j] * second_difference(ref.q, k) +
-                                  pid.kd[j] * second_difference(ref.dq, k));
-    }
-    const double limit = 0.5 * (torque.hi - torque.lo) + noise + 2.0 * rough;
-    // A swing is a change that reverses at the next sample, |Δτ_{k−1}| and |Δτ_k| both large with
-    // opposite signs (a mode at the Nyquist rate); a Coulomb step of the feed-forward at a
-    // velocity reversal is one change and no swing.
-    double jump = 0.0;
-    Eigen::Index jump_at = 1;
-    for (Eigen::Index k = 1; k + 1 < total; ++k) {
-      const double before = r.tau(k, j) - r.tau(k - 1, j), after = r.tau(k + 1, j) - r.tau(k, j);
-      const double swing = before * after < 0.0 ? std::min(std::abs(before), std::abs(after)) : 0.0;
-      if (swing > jump) {
-        jump = swing;
-        jump_at = k;
-      }
-    }
-    if (jump > limit && jump > 0.0) {
-      throw Error("simulate: the logged torque of joint " + model.joints[j].name +
-                  " chatters: it swings by " + short_number(jump) +
-                  " from sample to sample at t = " + short_number(r.t[jump_at]) +
-                  " s against a torque range of " + short_number(torque.hi - torque.lo) +
-                  " (a loop mode near the sample rate); such a run is not a data set" + gains_fix);
-    }
-  }
-}
-
 }  // namespace
 
 ClosedLoopResult simulate_reference(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& t,
@@ -366,15 +197,15 @@ ClosedLoopResult simulate_reference(const Model& model, const Eigen::Ref<const E
                 "; give parameters identified on this robot");
   auto plant = make_plant(model, options.plant);
   PidController pid(controller_model,
-                    simulation_pid_options(model, ref.q, info.rate_hz(), options));
+                    simulation_pid_options(model, q.row(0).transpose(), info.rate_hz(), options));
   if (controller_used != nullptr) *controller_used = pid.options();
   Sensors sensors(model, options.sensors);
-  // An unstable loop shows up as the plant's divergence or a joint leaving the reference's band,
-  // a bounded one as tracking error or chatter (check_tracking); the gains are then the likely
-  // fault, so the error names the flag that replaces them.
+  // An unstable loop shows up as the plant's divergence or a joint leaving the reference's band;
+  // the gains are then the likely fault (the default rule does not hold every arm: iiwa14,
+  // docs/methods/sim.md), so the error names the flag that replaces them.
   const std::string fix =
       options.gains.kp.size() > 0
-          ? "; these gains do not hold the arm: give other gains with --gains FILE"
+          ? "; if the loop is unstable, give other gains with --gains FILE"
           : "; the default gains (docs/methods/sim.md) may not hold this robot: give stable gains "
             "with --gains FILE (kp, ki, kd per joint)";
   ClosedLoopResult result;
@@ -384,7 +215,6 @@ ClosedLoopResult simulate_reference(const Model& model, const Eigen::Ref<const E
     throw Error(std::string("simulate: the closed loop failed: ") + e.what() + fix);
   }
   check_simulated_run(model, result, ref, options.sensors, fix);
-  check_tracking(model, result, ref, options.sensors, pid.options(), fix);
   return result;
 }
 
@@ -405,7 +235,8 @@ SimulationValidation validate_run_by_simulation(
   controller.feed_forward = feed_forward;
   controller.gains = gains;
   return validate_by_simulation(
-      identified, ref, simulation_pid_options(identified, ref.q, info.rate_hz(), controller),
+      identified, ref,
+      simulation_pid_options(identified, q.row(0).transpose(), info.rate_hz(), controller),
       q_measured, tau_measured, options);
 }
 

@@ -44,17 +44,16 @@ class SimulateCli : public ::testing::Test {
 };
 
 TEST_F(SimulateCli, GainsFileRoundTripsThroughTheRun) {
-  // Stiff enough for the plain PID to track (kp2 = 40 left the elbow 0.17 rad behind, an error).
-  std::ofstream(work("gains.yaml")) << "kp: [300, 150]\nki: [10, 5]\nkd: [30, 10]\n";
+  std::ofstream(work("gains.yaml")) << "kp: [300, 40]\nki: [10, 2.5]\nkd: [30, 4]\n";
   const auto r = run("simulate --robot planar2 --trajectory " + work("traj.csv") + " --out " +
                      work("run.csv") + " --engine native --periods 2 --controller pid --gains " +
                      work("gains.yaml"));
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json g = nlohmann::json::parse(std::ifstream(work("run.gains.json")));
   EXPECT_EQ(g["controller"], "pid");
-  EXPECT_EQ(g["kp"], nlohmann::json({300.0, 150.0}));
-  EXPECT_EQ(g["ki"], nlohmann::json({10.0, 5.0}));
-  EXPECT_EQ(g["kd"], nlohmann::json({30.0, 10.0}));
+  EXPECT_EQ(g["kp"], nlohmann::json({300.0, 40.0}));
+  EXPECT_EQ(g["ki"], nlohmann::json({10.0, 2.5}));
+  EXPECT_EQ(g["kd"], nlohmann::json({30.0, 4.0}));
   EXPECT_DOUBLE_EQ(g["sample_time"].get<double>(), 0.005);
   // The written file is a gains file: a second run with it writes the same gains.
   const auto r2 = run("simulate --robot planar2 --trajectory " + work("traj.csv") + " --out " +

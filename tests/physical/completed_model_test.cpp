@@ -71,14 +71,8 @@ TEST(CompletedModel, OneJointRunGivesAPositiveDefiniteModelThatPredictsAsWell) {
   fo.f0 = 0.2;
   const TrajectorySamples tr = sample_trajectory(
       FourierTrajectory(joint_fourier_reference(pose, 1, -0.6, 0.6, fo)), kRate, false);
-  // The held joints held stiffly, as in seed 2's one-joint runs: the single-configuration rule's
-  // gains (M_jj at the pose). simulate's reference rule divides by the coupling along the run,
-  // and its softer held joints then move above their noise (MY3 estimated at 7.8 ± 745 instead
-  // of not excited), which is not the run this test is about.
-  SimulateOptions so = testing::noisy_sensors(1e-5, 0.2, 7, 3);
-  const PidOptions stiff = default_pid_options(plant, tr.q.row(0).transpose(), kRate);
-  so.gains = {stiff.kp, stiff.ki, stiff.kd, ""};
-  const JointRecord record = testing::closed_loop_run(plant, tr, so);
+  const JointRecord record =
+      testing::closed_loop_run(plant, tr, testing::noisy_sensors(1e-5, 0.2, 7, 3));
   IdentifyOptions o;
   o.layout.armature = o.layout.viscous = o.layout.coulomb = true;
   o.signal.torque_time_offset = 0.5 / kRate;

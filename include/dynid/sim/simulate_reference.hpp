@@ -13,29 +13,15 @@
 
 namespace dynid {
 
-/// PID gains that hold the arm along a reference (docs/methods/sim.md, "default gain rule"): at
-/// up to 64 configurations q_k evenly spaced along q_reference (samples × n [rad or m]), D_j =
-/// min_k 1/(M(q_k)⁻¹)_jj (the "free" inertia, actuator inertia included) and μ = max(1, max_k
-/// λ_max(D^½·M(q_k)⁻¹·D^½)); kp = D·ω²/μ, so every mode of M(q)·ë = −K·e stays at or below ω in
-/// every configuration met; kd = kp·2ζ/ω (ζ = 0.9), ki = kp/2, derivative filter Tf ≥ 2 samples,
-/// sample time Ts = 1/rate, and
+/// PID gains that give every joint the same closed-loop bandwidth for its own inertia (diagonal
+/// of M(q0), actuator inertia included): kp = M_jj·ω², kd = 2ζ·M_jj·ω, ki = kp/2, ζ = 0.9,
+/// derivative filter Tf ≥ 2 samples, sample time Ts = 1/rate, and
 ///   ω = min(2π·8 Hz, 2π·rate/40, kLoopLagBudget / ((delay + 1)·Ts + Tf)),
-/// the lag bound active only with a delay. Without feed-forward (plain PID) each kp_j is raised to
-/// max_k|g_j(q_k)|/0.02 rad, at most D_j·ω² (a stiffness floor: a light joint holds its gravity
-/// torque). feed_forward: computed torque (seed 2 §3.6) or none (plain PID). Throws dynid::Error
-/// for rate_hz ≤ 0, delay_samples < 0, a reference of the wrong width or not finite, or a model
-/// giving a joint no inertia.
-PidOptions reference_pid_options(const Model& model,
-                                 const Eigen::Ref<const Eigen::MatrixXd>& q_reference,
-                                 double rate_hz, int delay_samples = 0,
-                                 FeedForward feed_forward = FeedForward::kComputedTorque);
-
-/// The earlier single-configuration rule, kept for the demo and the tests whose measured
-/// numbers rely on it (simulate uses reference_pid_options()): kp = M_jj(q0)·ω²/μ, kd =
-/// 2ζ·M_jj(q0)·ω/μ, ki = kp/2, ω as in reference_pid_options(), μ = λ_max(M⁻¹·diag M) at q0 for
-/// a plain PID or a delay and 1 for the delay-free feed-forward loop (whose coupled mode can then
-/// be unstable: planar2 stretched, iiwa14; docs/methods/sim.md). Throws dynid::Error for
-/// rate_hz ≤ 0 or delay_samples < 0.
+/// i.e. the bandwidth also shrinks with the loop's lag (measurement delay, zero-order hold plus
+/// computation, derivative filter) so that the phase margin stays the same with a measurement
+/// delay (docs/methods/sim.md). With delay_samples = 0 the lag bound is inactive and the gains are
+/// those of earlier releases. feed_forward: computed torque (seed 2 §3.6) or none (plain PID).
+/// Throws dynid::Error for rate_hz ≤ 0 or delay_samples < 0.
 PidOptions default_pid_options(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q0,
                                double rate_hz, int delay_samples = 0,
                                FeedForward feed_forward = FeedForward::kComputedTorque);
@@ -57,18 +43,17 @@ struct SimulateOptions {
   SensorOptions sensors;   ///< quantisation, noise, delays
   ClosedLoopOptions loop;  ///< periods (25), truth recording
   FeedForward feed_forward = FeedForward::kComputedTorque;  ///< kNone = plain PID (seed 2 §2.2)
-  PidGains gains;  ///< user gains; empty kp = reference_pid_options() for the position delay
+  PidGains gains;  ///< user gains; empty kp = default_pid_options() for the position delay
   /// The model inside the controller (feed-forward, computed-torque law), e.g. identified_model()
   /// of a result; empty = the plant's model. Same joints as the plant's model.
   std::optional<Model> controller_model;
 };
 
-/// The controller simulate_reference() runs for a reference q_reference (samples × n) sampled at
-/// rate_hz: options.gains when given (the rest of the default options kept), else
-/// reference_pid_options() with options.sensors.position_delay; options.feed_forward in both
-/// cases. Throws dynid::Error for gains of the wrong size, negative or non-finite.
-PidOptions simulation_pid_options(const Model& model,
-                                  const Eigen::Ref<const Eigen::MatrixXd>& q_reference,
+/// The controller simulate_reference() runs for a reference starting at q0 sampled at rate_hz:
+/// options.gains when given (the rest of the default options kept), else default_pid_options()
+/// with options.sensors.position_delay; options.feed_forward in both cases. Throws dynid::Error
+/// for gains of the wrong size, negative or non-finite.
+PidOptions simulation_pid_options(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& q0,
                                   double rate_hz, const SimulateOptions& options);
 
 /// Runs one periodic reference (t uniform, one period; a last sample equal to the first is the
