@@ -7,7 +7,8 @@
 // - stderr is valid UTF-8 without control characters (besides the line ends);
 // - a failed run leaves nothing in its output folder (no partial file, no temporary);
 // - a successful run writes no non-finite number: every CSV field parses as a finite number, and a
-//   JSON null appears only where the model JSON documents it (root parent, unlimited limits).
+//   JSON null appears only where the model JSON documents it (root parent, unlimited limits) and
+//   where identify documents it (nominal: the model file has no value).
 // The mutations are drawn from a fixed seed, so every case is the same on every run. Each command
 // is one test; a failing case is reported with its command line and the folder holding its inputs
 // (kept under $TMPDIR/dynid_cli_fuzz/COMMAND.PID/, with replay.sh and `args`) so that it can be
@@ -195,7 +196,9 @@ void check_json_output(const std::string& name, const std::string& text,
     problems.push_back(name + " is not valid JSON");
     return;
   }
-  const std::vector<std::string> may_be_null{"parent", "lower", "upper", "velocity", "effort"};
+  // nominal: a base parameter the model file gives no value for (docs/cli.md, identify).
+  const std::vector<std::string> may_be_null{"parent",   "lower",  "upper",
+                                             "velocity", "effort", "nominal"};
   std::function<void(const nlohmann::json&, const std::string&, const std::string&)> walk =
       [&](const nlohmann::json& v, const std::string& key, const std::string& where) {
         if (v.is_null()) {
