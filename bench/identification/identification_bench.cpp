@@ -31,6 +31,15 @@ void bench_state(long k, Eigen::VectorXd& q, Eigen::VectorXd& dq, Eigen::VectorX
   }
 }
 
+// Samples per second and the process's peak memory so far (kB on Linux).
+void throughput_counters(benchmark::State& st, long samples) {
+  st.counters["samples_per_s"] = benchmark::Counter(static_cast<double>(samples),
+                                                    benchmark::Counter::kIsIterationInvariantRate);
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  st.counters["peak_rss_MiB"] = usage.ru_maxrss / 1024.0;
+}
+
 std::string run_file(const dynid::Model& model, long samples) {
   const std::string path = (std::filesystem::temp_directory_path() /
                             ("dynid_bench_iiwa14_" + std::to_string(samples) + ".csv"))
@@ -79,11 +88,7 @@ void BM_IdentifyStream(benchmark::State& st) {
     const auto r = dynid::identify_stream(model, path, {}, o, so);
     benchmark::DoNotOptimize(r.estimate.x.data());
   }
-  st.counters["samples_per_s"] = benchmark::Counter(static_cast<double>(samples),
-                                                    benchmark::Counter::kIsIterationInvariantRate);
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  st.counters["peak_rss_MiB"] = usage.ru_maxrss / 1024.0;  // process peak so far (kB on Linux)
+  throughput_counters(st, samples);
   st.counters["file_MiB"] = std::filesystem::file_size(path) / 1048576.0;
 }
 
@@ -120,11 +125,7 @@ void BM_IdentifyBatch(benchmark::State& st) {
     const auto result = dynid::identify(model, r, o);
     benchmark::DoNotOptimize(result.estimate.x.data());
   }
-  st.counters["samples_per_s"] = benchmark::Counter(static_cast<double>(samples),
-                                                    benchmark::Counter::kIsIterationInvariantRate);
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  st.counters["peak_rss_MiB"] = usage.ru_maxrss / 1024.0;  // process peak so far (kB on Linux)
+  throughput_counters(st, samples);
 }
 
 }  // namespace
