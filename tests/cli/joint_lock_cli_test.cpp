@@ -160,8 +160,8 @@ TEST_F(JointLockCli, IdentifyRecoversTheHeldArmAndLaterCommandsReuseTheLocks) {
   const std::string data = write_run("run.csv", arm, false, true);
   const std::string result = path("result.json");
   JointLockRun r = run("identify --robot " + kRobot + " --data " + data + " --out " + result +
-                 " --joints shoulder,elbow --lock finger=0.05,camera_pan=3.141592653589793 "
-                 "--friction none --no-armature --filter none --physical");
+                       " --joints shoulder,elbow --lock finger=0.05,camera_pan=3.141592653589793 "
+                       "--friction none --no-armature --filter none --physical");
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json j = load(result);
   ASSERT_EQ(j["locked_joints"].size(), 2u) << j["locked_joints"].dump();
