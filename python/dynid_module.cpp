@@ -521,7 +521,8 @@ nlohmann::json payload_from_torques(const Model& model, const std::string& link_
 }  // namespace
 }  // namespace dynid
 
-PYBIND11_MODULE(dynid, m) {
+// The compiled half of the Python package dynid (python/dynid/__init__.py re-exports it).
+PYBIND11_MODULE(_core, m) {
   using namespace dynid;
   m.doc() =
       "dynid: identification of robot dynamic parameters (link inertias, actuator inertias, joint "
