@@ -470,10 +470,18 @@ Estimate StreamingLeastSquares::solve(const Eigen::VectorXd& weights, EstimatorK
                                                      column_list(options, s.dependent_columns)
                                                : options.rank_deficient_remedy));
   }
-  if (s.condition_number > options.condition_warning) {
-    e.summary.warnings.push_back("condition number " + short_number(s.condition_number) +
-                                 " exceeds " + short_number(options.condition_warning) +
-                                 ": the data excite some parameters poorly");
+  // A column zero by design (a load inertia a planar run cannot reach) makes σ_min 0 and the
+  // condition number infinite; the rank warning above names those parameters, so what this one
+  // reports is the conditioning of the r directions the data do determine, σ_max/σ_r.
+  const bool deficient = s.rank < p && s.rank > 0;
+  const double conditioning =
+      deficient ? s.singular_values(0) / s.singular_values(s.rank - 1) : s.condition_number;
+  if (conditioning > options.condition_warning) {
+    e.summary.warnings.push_back(
+        "condition number " + short_number(conditioning) +
+        (deficient ? " of the " + std::to_string(s.rank) + " determined directions" : "") +
+        " exceeds " + short_number(options.condition_warning) +
+        ": the data excite some parameters poorly");
     if (s.rank == p) {
       // Parameters dominating the weakest singular direction.
       for (Eigen::Index j = 0; j < p; ++j) {

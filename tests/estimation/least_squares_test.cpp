@@ -394,12 +394,15 @@ TEST(OrdinaryLeastSquares, WarningsUseShortNumbersAndTheCallersRemedy) {
   std::normal_distribution<double> g;
   Eigen::MatrixXd W(200, 3);
   for (Eigen::Index i = 0; i < W.rows(); ++i) {
-    const double a = g(rng), b = g(rng);
-    W.row(i) << a, b, a + 1e-6 * b;  // cond(W) ~ 1e6: above the 1e4 warning
+    const double a = g(rng), b = g(rng), c = g(rng);
+    // cond(W) ~ 1e6, above the 1e4 warning, at full rank (a third column a + 1e-6·b would be an
+    // exact combination of the first two: rank 2, cond 1e15 from round-off).
+    W.row(i) << a, b, a + 1e-6 * c;
   }
   Eigen::VectorXd y = W * Eigen::Vector3d(1, 2, 3);
   for (Eigen::Index i = 0; i < y.size(); ++i) y[i] += 0.01 * g(rng);
   const Estimate e = ordinary_least_squares(W, y);
+  ASSERT_EQ(e.summary.rank, 3);
   std::string condition;
   for (const auto& w : e.summary.warnings)
     if (w.rfind("condition number ", 0) == 0) condition = w;
@@ -419,8 +422,21 @@ TEST(OrdinaryLeastSquares, WarningsUseShortNumbersAndTheCallersRemedy) {
       if (w.rfind("W is rank deficient", 0) == 0) return w;
     return std::string();
   };
-  const std::string plain = rank_warning(ordinary_least_squares(Z, y, Eigen::VectorXi(), options));
+  const Estimate zero_column = ordinary_least_squares(Z, y, Eigen::VectorXi(), options);
+  const std::string plain = rank_warning(zero_column);
   EXPECT_NE(plain.find("regroup them into base parameters"), std::string::npos) << plain;
+  // The zero column is named by the rank warning; no warning speaks of an infinite condition
+  // number, and the determined columns a and b are well conditioned (independent Gaussians).
+  EXPECT_TRUE(std::isinf(zero_column.summary.condition_number));
+  for (const auto& w : zero_column.summary.warnings)
+    EXPECT_EQ(w.find("number inf"), std::string::npos) << w;
+  Eigen::MatrixXd Zc = W;
+  Zc.col(1) = Zc.col(0) + 1e-6 * Zc.col(1);  // columns 1, 2 nearly collinear: cond ~ 1e6 ...
+  Zc.col(2).setZero();                       // ... beside a column zero by design
+  std::string weak;
+  for (const auto& w : ordinary_least_squares(Zc, y, Eigen::VectorXi(), options).summary.warnings)
+    if (w.rfind("condition number ", 0) == 0) weak = w;
+  EXPECT_NE(weak.find(" of the 2 determined directions exceeds 1e+04"), std::string::npos) << weak;
   options.rank_deficient_remedy = "record a longer run";
   const std::string own = rank_warning(ordinary_least_squares(Z, y, Eigen::VectorXi(), options));
   EXPECT_NE(own.find("parameters c are not identifiable individually; record a longer run"),
