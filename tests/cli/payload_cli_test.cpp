@@ -356,6 +356,36 @@ TEST_F(PayloadCli, SimulatedSensorRunGivesTheLoadBack) {
   EXPECT_FALSE(fs::exists(dir_ / "z.csv"));
 }
 
+// Issue 26 item 6: a planar arm turns its sensor about one axis only, so the load's Ixx, Ixy and
+// Iyy have zero columns by design. The run still gives the mass and centre of mass; the rank
+// warning names the three inertias, no warning speaks of an infinite condition number, and the
+// load is not called inconsistent for inertias the data never determined (their minimum-norm
+// value 0 is no violation the load made).
+TEST_F(PayloadCli, PlanarMotionJudgesOnlyWhatItDetermines) {
+  ASSERT_EQ(run("excite --robot planar2 --family fourier --joint 2 --range -1:1 --out " +
+                path("traj.csv"))
+                .code,
+            0);
+  std::ofstream(path("load.yaml")) << "mass: 2.0\ncom: [0, 0, 0.05]\n"
+                                      "inertia_com: [0.004, 0, 0, 0.004, 0, 0.002]\n";
+  const auto sim =
+      run("simulate --robot planar2 --periods 2 -q --trajectory " + path("traj.csv") +
+          " --payload " + path("load.yaml") + " --payload-link elbow --out " + path("run.csv"));
+  ASSERT_EQ(sim.code, 0) << sim.err;
+  const auto r = run("payload --robot planar2 --sensor-link elbow --quiet --data " +
+                     path("run.csv") + " --out " + path("load.json"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find("number inf"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("rank deficient"), std::string::npos) << r.err;
+  const nlohmann::json j = json("load.json");
+  const auto not_excited = j.at("not_excited").get<std::vector<std::string>>();
+  for (const char* name : {"Ixx", "Ixy", "Iyy"}) {
+    EXPECT_NE(std::find(not_excited.begin(), not_excited.end(), name), not_excited.end()) << name;
+  }
+  EXPECT_TRUE(j.at("physically_consistent").get<bool>()) << j.dump();
+  EXPECT_NEAR(j.at("mass").get<double>(), 2.0, 0.01);
+}
+
 // Issue 25 item 4: the payload's cut-off by the spectral rule alone sat just above the motion's
 // band, where the load's ω×(ω×c) and ω̇ terms (products and derivatives of the motion) do not
 // commute with the low-pass, and biased the centre of mass and inertias. A 5-harmonic, 0.2 Hz

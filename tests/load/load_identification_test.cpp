@@ -365,7 +365,7 @@ TEST(LoadIdentification, PhysicalConsistencyNamesTheViolatedCondition) {
   EXPECT_NE(load_physics(bad, true).violated.find("positive definite"), std::string::npos);
   bad = phi;
   bad(0) = -1.0;
-  EXPECT_NE(load_physics(bad, true).violated.find("m > 0"), std::string::npos);
+  EXPECT_NE(load_physics(bad, true).violated.find("mass not positive"), std::string::npos);
 }
 
 // Load from joint torques (no sensor): a loaded and an unloaded run of the puma560 over different

@@ -170,7 +170,7 @@ struct LoadPhysics {
   Eigen::Vector3d com = Eigen::Vector3d::Zero();          ///< c = mc/m [m], sensor frame
   Eigen::Matrix3d inertia_com = Eigen::Matrix3d::Zero();  ///< I_C (seed 1 eq. 24) [kg·m²]
   bool consistent = false;  ///< m > 0, I_C positive definite, triangle inequalities
-  std::string violated;     ///< the first violated condition, empty when consistent
+  std::string violated;     ///< what breaks the first violated condition, empty when consistent
 };
 
 /// c = mc/m and I_C = I_P − m[(cᵀc)·1 − c·cᵀ] (seed 1 eq. 24) from
