@@ -47,6 +47,7 @@ struct PayloadCliOptions {
   std::string model = "differential";
   std::string estimator = "ols";
   std::string gravity = "0 0 -9.81";
+  std::string components;  // --components: the wrench equations used, default all six
   double interval = 0.2, wrench_sign = 1.0, confidence = 0.999, cutoff = 0.0;
   bool bias = false, standing = false, no_filter = false;
   bool quiet = false;  // --quiet
@@ -271,6 +272,14 @@ void run_payload(const PayloadCliOptions& cli, const CLI::App& cmd) {
   equations.interval = cli.interval;
   equations.bias = cli.bias;
   equations.wrench_sign = cli.wrench_sign;
+  if (!cli.components.empty()) {
+    if (!cli.link.empty()) {
+      throw UsageError(
+          "--components chooses among a wrist sensor's six equations; a load from joint torques "
+          "(--link) has none: drop --components");
+    }
+    equations.components = load_components_from_text(cli.components, "--components");
+  }
   LoadIdentificationOptions options;
   options.confidence_level = cli.confidence;
   if (cli.estimator == "ols") {
@@ -402,6 +411,7 @@ void run_payload(const PayloadCliOptions& cli, const CLI::App& cmd) {
                                                                          : "differential";
   nlohmann::json extra = {{"wrench_sign", cli.wrench_sign}};
   if (equations.model == LoadModelKind::kIntegral) extra["interval"] = cli.interval;
+  extra["components"] = block.group_names;
   write_result(cli, r, model_name, frame, extra, choices, block.group_names,
                equations.model != LoadModelKind::kStatic);
 }
@@ -440,6 +450,11 @@ void add_payload_command(CLI::App& app) {
   cmd->add_option("--interval", o->interval,
                   "Integral model: window length [s] (consecutive, non-overlapping)")
       ->capture_default_str();
+  cmd->add_option("--components", o->components,
+                  "Comma-separated wrench equations to use, of fx,fy,fz,mx,my,mz (default all "
+                  "six): forces determine m and mc, moments mc and the inertias; Dutkiewicz, "
+                  "Kozlowski, Wroblewski (1993) found the integral model better on the "
+                  "components the motion excites");
   cmd->add_flag("--bias", o->bias,
                 "Identify the six constant sensor offsets fx0 fy0 fz0 mx0 my0 mz0 too");
   cmd->add_flag("--static", o->standing,

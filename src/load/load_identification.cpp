@@ -217,9 +217,34 @@ std::vector<std::string> load_parameter_names(const LoadEquationOptions& options
     for (const char* name : {"Ixx", "Ixy", "Ixz", "Iyy", "Iyz", "Izz"}) names.emplace_back(name);
   }
   if (options.bias) {
-    for (const char* c : kComponents) names.push_back(std::string(c) + "0");
+    for (int c = 0; c < 6; ++c) {
+      if (options.components[c]) names.push_back(std::string(kComponents[c]) + "0");
+    }
   }
   return names;
+}
+
+std::array<bool, 6> load_components_from_text(const std::string& list, const std::string& flag) {
+  std::array<bool, 6> chosen = {false, false, false, false, false, false};
+  bool any = false;
+  std::size_t begin = 0;
+  while (begin <= list.size()) {
+    const std::size_t end = std::min(list.find(',', begin), list.size());
+    const std::string name = list.substr(begin, end - begin);
+    const auto it = std::find_if(std::begin(kComponents), std::end(kComponents),
+                                 [&](const char* c) { return name == c; });
+    if (it == std::end(kComponents)) {
+      throw UsageError(flag + " '" + list + "': '" + name +
+                       "' is not a wrench component; give a comma-separated list of fx, fy, fz, "
+                       "mx, my, mz");
+    }
+    auto& slot = chosen[static_cast<std::size_t>(it - std::begin(kComponents))];
+    if (slot) throw UsageError(flag + " '" + list + "' names '" + name + "' twice; name it once");
+    slot = any = true;
+    begin = end + 1;
+  }
+  if (!any) throw UsageError(flag + " is empty; give some of fx, fy, fz, mx, my, mz");
+  return chosen;
 }
 
 EquationBlock load_equations(const SensorMotion& motion,
@@ -245,32 +270,41 @@ EquationBlock load_equations(const SensorMotion& motion,
   }
   EquationBlock block;
   block.columns = load_parameter_names(options);
-  block.group_names.assign(std::begin(kComponents), std::end(kComponents));
+  // The chosen scalar equations (seed 1 §VI-B): rows of the other components are never formed.
+  std::vector<int> rows_of;
+  for (int c = 0; c < 6; ++c) {
+    if (options.components[c]) {
+      rows_of.push_back(c);
+      block.group_names.emplace_back(kComponents[c]);
+    }
+  }
+  if (rows_of.empty()) throw UsageError("no wrench component is chosen; choose some of fx..mz");
+  const auto c_rows = static_cast<Eigen::Index>(rows_of.size());
   const auto p = static_cast<Eigen::Index>(block.columns.size());
   const Eigen::Index inertial = standing ? 4 : 10;
   // Seed 1's W is the wrench the sensor exerts on the load: the negative of a driver's reading.
   const double to_seed = -options.wrench_sign;
-  auto fill = [&](Eigen::Index row0, Eigen::Index index, double time,
-                  const Eigen::Matrix<double, 6, 10>& K, const Eigen::Matrix<double, 6, 1>& y,
-                  double bias_scale) {
-    block.W.block(row0, 0, 6, inertial) = K.leftCols(inertial);
-    if (options.bias) {
-      block.W.block(row0, inertial, 6, 6) =
-          to_seed * bias_scale * Eigen::Matrix<double, 6, 6>::Identity();
-    }
-    block.y.segment<6>(row0) = y;
-    for (int c = 0; c < 6; ++c) {
-      block.group(row0 + c) = c;
-      block.sample(row0 + c) = static_cast<int>(index);
-      block.t(row0 + c) = time;
+  // Equation `index` fills rows c_rows·index … of its chosen components; the bias column of the
+  // i-th chosen component is inertial + i.
+  auto fill = [&](Eigen::Index index, double time, const Eigen::Matrix<double, 6, 10>& K,
+                  const Eigen::Matrix<double, 6, 1>& y, double bias_scale) {
+    for (Eigen::Index i = 0; i < c_rows; ++i) {
+      const Eigen::Index row = c_rows * index + i;
+      const int c = rows_of[static_cast<std::size_t>(i)];
+      block.W.row(row).head(inertial) = K.row(c).head(inertial);
+      if (options.bias) block.W(row, inertial + i) = to_seed * bias_scale;
+      block.y(row) = y(c);
+      block.group(row) = static_cast<int>(i);
+      block.sample(row) = static_cast<int>(index);
+      block.t(row) = time;
     }
   };
   auto resize = [&](Eigen::Index equations) {
-    block.W.setZero(6 * equations, p);
-    block.y.resize(6 * equations);
-    block.group.resize(6 * equations);
-    block.sample.resize(6 * equations);
-    block.t.resize(6 * equations);
+    block.W.setZero(c_rows * equations, p);
+    block.y.resize(c_rows * equations);
+    block.group.resize(c_rows * equations);
+    block.sample.resize(c_rows * equations);
+    block.t.resize(c_rows * equations);
   };
   const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
   if (standing && m < (options.bias ? 3 : 2)) {
@@ -285,7 +319,7 @@ EquationBlock load_equations(const SensorMotion& motion,
       const auto K = standing ? load_regressor(zero, zero, zero, row3(motion.g, k))
                               : load_regressor(row3(motion.w, k), row3(motion.dw, k),
                                                row3(motion.a, k), row3(motion.g, k));
-      fill(6 * k, k, standing ? 0.0 : motion.t(k), K, to_seed * wrench.row(k).transpose(), 1.0);
+      fill(k, standing ? 0.0 : motion.t(k), K, to_seed * wrench.row(k).transpose(), 1.0);
     }
     return block;
   }
@@ -300,7 +334,7 @@ EquationBlock load_equations(const SensorMotion& motion,
   const auto per_window =
       std::max<Eigen::Index>(1, static_cast<Eigen::Index>(std::llround(options.interval / step)));
   const Eigen::Index windows = (m - 1) / per_window;
-  if (6 * windows < p + 1) {
+  if (c_rows * windows < p + 1) {
     throw Error("the run of " + short_number(span) + " s gives " + std::to_string(windows) +
                 " integration windows of " + short_number(options.interval) + " s, too few for " +
                 std::to_string(p) + " parameters; shorten --interval or record a longer run");
@@ -327,7 +361,7 @@ EquationBlock load_equations(const SensorMotion& motion,
     const Eigen::Vector3d dv =
         have_v ? Eigen::Vector3d(row3(motion.v, k1) - row3(motion.v, k0)) : zero;
     K += load_regressor(zero, row3(motion.w, k1) - row3(motion.w, k0), dv, zero);
-    fill(6 * w, w, motion.t(k1), K, y, motion.t(k1) - motion.t(k0));
+    fill(w, motion.t(k1), K, y, motion.t(k1) - motion.t(k0));
   }
   return block;
 }
@@ -534,14 +568,22 @@ LoadIdentificationResult identify_load(const EquationBlock& block,
                                        const LoadIdentificationOptions& options) {
   LoadIdentificationResult out;
   out.names = block.columns;
+  // A subset of the six equations (seed 1 §VI-B) may leave m (moments only) or the inertias
+  // (forces only) undetermined by design: that is the user's choice, reported, not an error.
+  const bool subset = block.group_names.size() < 6;
   out.estimate = estimate_block(
       block, options, &out.history,
-      "the run does not excite them: record one that turns the sensor through more orientations "
-      "with larger angular velocities and accelerations, or give --static to identify m and mc "
-      "only; they are listed under not_excited");
+      subset ? "the chosen --components do not determine them (forces determine m and mc, "
+               "moments mc and the inertias); they are listed under not_excited"
+             : "the run does not excite them: record one that turns the sensor through more "
+               "orientations with larger angular velocities and accelerations, or give --static "
+               "to identify m and mc only; they are listed under not_excited");
   const Estimate& e = out.estimate;
-  if (std::any_of(e.unidentifiable.begin(), e.unidentifiable.end(),
-                  [](Eigen::Index j) { return j < 4; })) {
+  const auto undetermined = [&](Eigen::Index first, Eigen::Index last) {
+    return std::any_of(e.unidentifiable.begin(), e.unidentifiable.end(),
+                       [&](Eigen::Index j) { return j >= first && j < last; });
+  };
+  if (!subset && undetermined(0, 4)) {
     std::string names;
     for (const Eigen::Index j : e.unidentifiable) {
       names += (names.empty() ? "" : ", ") + out.names[static_cast<std::size_t>(j)];
@@ -550,7 +592,7 @@ LoadIdentificationResult identify_load(const EquationBlock& block,
                 ": gravity keeps one direction in the sensor frame (the poses are all the same); "
                 "record poses or a motion with several sensor orientations");
   }
-  check_mass(e);
+  if (!undetermined(0, 1)) check_mass(e);
   std::vector<bool> flagged(out.names.size(), false);
   for (const Eigen::Index j : e.unidentifiable) flagged[j] = true;
   const auto first_inertia = std::find(out.names.begin(), out.names.end(), "Ixx");
@@ -583,11 +625,11 @@ LoadIdentificationResult identify_load(const EquationBlock& block,
   // An inertia the runs cannot reach (a planar motion leaves Ixx, Ixy, Iyy in W's null space) has
   // the minimum-norm value 0, and judging I_C ≻ 0 on it reports a violation the data never made:
   // as with the static model, only what the data determine is checked; not_excited names the rest.
-  bool inertia_determined = with_inertia;
-  for (const Eigen::Index j : e.unidentifiable) {
-    if (j >= 4 && j < kLinkParams) inertia_determined = false;  // Ixx … Izz follow m, mc
+  out.physics = load_physics(e.x, with_inertia && !undetermined(4, kLinkParams));
+  if (undetermined(0, 4)) {
+    out.physics.consistent = false;
+    out.physics.violated = "the mass or centre of mass is not determined by the chosen components";
   }
-  out.physics = load_physics(e.x, inertia_determined);
   return out;
 }
 

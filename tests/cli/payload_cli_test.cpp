@@ -384,6 +384,19 @@ TEST_F(PayloadCli, PlanarMotionJudgesOnlyWhatItDetermines) {
   }
   EXPECT_TRUE(j.at("physically_consistent").get<bool>()) << j.dump();
   EXPECT_NEAR(j.at("mass").get<double>(), 2.0, 0.01);
+  // The force equations alone (seed 1 §VI-B): the mass, and what is not excited is named.
+  const auto f =
+      run("payload --robot planar2 --sensor-link elbow --quiet --components fz,fx,fy "
+          "--data " +
+          path("run.csv") + " --out " + path("forces.json"));
+  ASSERT_EQ(f.code, 0) << f.err;
+  const nlohmann::json jf = json("forces.json");
+  EXPECT_EQ(jf.at("components"), nlohmann::json({"fx", "fy", "fz"}));
+  EXPECT_NEAR(jf.at("mass").get<double>(), 2.0, 0.01);
+  // In the plane of motion the forces see m·(a − g) and mcx, mcy; mcz moves only the moments
+  // (gravity × mcz), which are left out: it is named with the six inertias.
+  EXPECT_EQ(jf.at("not_excited"),
+            nlohmann::json({"mcz", "Ixx", "Ixy", "Ixz", "Iyy", "Iyz", "Izz"}));
 }
 
 // Issue 25 item 4: the payload's cut-off by the spectral rule alone sat just above the motion's
@@ -469,6 +482,12 @@ TEST_F(PayloadCli, BadInputsGiveOneErrorLine) {
   // Missing wrench columns.
   std::ofstream(path("nowrench.csv")) << "t,q1,q2,q3,q4,q5,q6,fx,fy\n0,0,0,0,0,0,0,1,1\n";
   expect_error(run(robot + path("nowrench.csv")), 1, "fz mx my mz");
+  // --components: unknown or repeated names, and joint-torque mode, which has no such equations.
+  expect_error(run(robot + path("run.csv") + " --components fx,torque"), 2, "'torque'");
+  expect_error(run(robot + path("run.csv") + " --components fx,fx"), 2, "twice");
+  expect_error(run("payload --robot puma560 --link link6 --reference " + path("run.csv") +
+                   " --components fx --out " + path("load.json") + " --data " + path("run.csv")),
+               2, "--components");
   // Zero-norm gravity, non-unit quaternion, too few / identical poses, no load.
   std::ofstream(path("quat.csv")) << "qx,qy,qz,qw,fx,fy,fz,mx,my,mz\n"
                                      "0,0,0,1,0,0,-18.7,0.1,0.2,0\n"

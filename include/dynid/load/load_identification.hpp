@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <string>
 #include <utility>
 #include <vector>
@@ -102,20 +103,29 @@ struct LoadEquationOptions {
   /// +1: the columns are the force and moment the load exerts on the sensor (drivers' convention,
   /// a load at rest reads +m·g); −1: the ones the sensor exerts on the load (seed 1's F, N).
   double wrench_sign = 1.0;
+  /// Which scalar equations of eq. 28/29 enter, in the order fx fy fz mx my mz: seed 1 §VI-B found
+  /// the integral model better on the components the motion excites. Forces determine m and mc,
+  /// moments mc and the inertias; what the chosen rows leave undetermined is named not_excited.
+  std::array<bool, 6> components = {true, true, true, true, true, true};
 };
 
+/// The --components list "fx,fy,mz" (any order, no repeats) as LoadEquationOptions::components.
+/// Throws dynid::UsageError naming `flag` for an empty list, a repeat or an unknown name.
+std::array<bool, 6> load_components_from_text(const std::string& list, const std::string& flag);
+
 /// Names of the load parameters in column order: m mcx mcy mcz [Ixx Ixy Ixz Iyy Iyz Izz, unless
-/// static] [fx0 fy0 fz0 mx0 my0 mz0 with bias].
+/// static] [fx0 fy0 fz0 mx0 my0 mz0 with bias, those of the chosen components].
 std::vector<std::string> load_parameter_names(const LoadEquationOptions& options);
 
 /// The load's equations as an EquationBlock: y = −wrench_sign·reading (seed 1's W), W = K (eq. 28)
 /// per sample, ∫K dt per window (eqs. 29–31, trapezoidal rule, ∫K dt = Σ K(ω, 0, ω×v, g)·dt +
 /// K(0, Δω, Δv, 0)), or K's m/mc columns for standing poses; bias columns −wrench_sign·I₆ (·T for
-/// a window). One row per wrench component and sample/window; group = component (fx fy fz mx my
-/// mz), sample = sample/window index, t = its time (window end). wrench: m×6 [N, N·m], sensor
-/// frame. Throws dynid::Error: size mismatch, NaN/Inf, missing t or ω̇/p̈ where the model needs
-/// them, an interval shorter than one sample step or giving fewer windows than parameters need,
-/// fewer standing poses than the static model needs (2, or 3 with biases).
+/// a window). One row per chosen wrench component and sample/window; group = component (the
+/// chosen ones of fx fy fz mx my mz, in that order), sample = sample/window index, t = its time
+/// (window end). wrench: m×6 [N, N·m], sensor frame. Throws dynid::Error: size mismatch, NaN/Inf,
+/// missing t or ω̇/p̈ where the model needs them, an interval shorter than one sample step or giving
+/// fewer windows than parameters need, fewer standing poses than the static model needs (2, or 3
+/// with biases).
 EquationBlock load_equations(const SensorMotion& motion,
                              const Eigen::Ref<const Eigen::MatrixXd>& wrench,
                              const LoadEquationOptions& options);
