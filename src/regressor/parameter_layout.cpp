@@ -1,5 +1,8 @@
 #include "dynid/regressor/parameter_layout.hpp"
 
+#include <cctype>
+#include <string>
+
 namespace dynid {
 
 ParameterLayout ParameterLayout::full() {
@@ -38,6 +41,30 @@ std::vector<std::string> ParameterLayout::names(int dof) const {
     if (offset) out.push_back("Fo" + k);
   }
   return out;
+}
+
+std::string parameter_unit(const Model& model, const std::string& name) {
+  std::size_t digits = name.find_first_of("0123456789");
+  if (digits == std::string::npos || digits == 0) return "";
+  const std::string kind = name.substr(0, digits);
+  std::size_t end = digits;
+  while (end < name.size() && std::isdigit(static_cast<unsigned char>(name[end]))) ++end;
+  if (end < name.size() && name.substr(end) != "R") return "";
+  if (end - digits > 4) return "";  // more joints than kMaxJoints allows
+  const int joint = std::stoi(name.substr(digits, end - digits));
+  if (joint < 1 || joint > model.dof()) return "";
+  if (kind == "M") return "kg";
+  if (kind == "MX" || kind == "MY" || kind == "MZ") return "kg·m";
+  for (const char* inertia : {"XX", "XY", "XZ", "YY", "YZ", "ZZ"}) {
+    if (kind == inertia) return "kg·m²";
+  }
+  const bool prismatic = model.joints[joint - 1].type == JointType::kPrismatic;
+  if (kind == "Ia") return prismatic ? "kg" : "kg·m²";
+  if (kind == "Fv" || kind == "Fvp" || kind == "Fvn") return prismatic ? "N·s/m" : "N·m·s/rad";
+  if (kind == "Fc" || kind == "Fcp" || kind == "Fcn" || kind == "Fo") {
+    return prismatic ? "N" : "N·m";
+  }
+  return "";
 }
 
 Eigen::VectorXd ParameterLayout::parameters(const Model& model) const {

@@ -129,6 +129,9 @@ void add_parameters(const Json& result, Json& section) {
   if (params.empty()) return;
   Json labels = Json::array(), low = Json::array(), high = Json::array(), value = Json::array(),
        colors = Json::array(), tips = Json::array(), rows = Json::array();
+  // Every parameter's %σ on a log axis: wide intervals do not saturate it (issue 28 item 4).
+  Json all_labels = Json::array(), sigma = Json::array(), sigma_colors = Json::array();
+  std::vector<std::string> wide;
   bool nominal = false;
   for (const auto& p : params) {
     if (!p.is_object()) continue;
@@ -138,16 +141,26 @@ void add_parameters(const Json& result, Json& section) {
     const double hi = number_or_nan(p.value("ci_high", Json()));
     const double rel = number_or_nan(p.value("relative_std_percent", Json()));
     const double scale = std::abs(v) > 0.0 ? std::abs(v) : 1.0;
-    labels.push_back(name);
-    value.push_back(rounded(v / scale, 6));
-    low.push_back(rounded(lo / scale, 6));
-    high.push_back(rounded(hi / scale, 6));
-    colors.push_back(!(rel < 20.0) ? "#d62728" : rel < 5.0 ? "#2ca02c" : "#ff9f1c");
-    std::ostringstream tip;
-    tip.precision(5);
-    tip << name << " = " << v << "  [" << lo << ", " << hi << "]  σ " << rel << " %";
-    tips.push_back(tip.str());
-    rows.push_back({name, text_of(p.value("value", Json())), text_of(p.value("std", Json())),
+    const std::string unit = text_of(p.value("unit", Json("")));
+    const char* color = !(rel < 20.0) ? "#d62728" : rel < 5.0 ? "#2ca02c" : "#ff9f1c";
+    all_labels.push_back(name);
+    sigma.push_back(std::isfinite(rel) && rel > 0.0 ? Json(rounded(rel, 4)) : Json());
+    sigma_colors.push_back(color);
+    if (rel < 20.0) {
+      labels.push_back(name);
+      value.push_back(rounded(v / scale, 6));
+      low.push_back(rounded(lo / scale, 6));
+      high.push_back(rounded(hi / scale, 6));
+      colors.push_back(color);
+      std::ostringstream tip;
+      tip.precision(5);
+      tip << name << " = " << v << " " << unit << "  [" << lo << ", " << hi << "]  σ " << rel
+          << " %";
+      tips.push_back(tip.str());
+    } else {
+      wide.push_back(name);
+    }
+    rows.push_back({name, text_of(p.value("value", Json())), unit, text_of(p.value("std", Json())),
                     text_of(p.value("relative_std_percent", Json())),
                     text_of(p.value("ci_low", Json())), text_of(p.value("ci_high", Json()))});
     // The nominal model's value beside the estimate (identify results; n/a where it has none).
@@ -156,7 +169,7 @@ void add_parameters(const Json& result, Json& section) {
       rows.back().push_back(text_of(p["nominal"]));
     }
   }
-  Json columns = {"name", "value", "std", "%σ", "ci low", "ci high"};
+  Json columns = {"name", "value", "unit", "std", "%σ", "ci low", "ci high"};
   if (nominal) {
     columns.push_back("nominal");
     for (auto& row : rows)
@@ -166,19 +179,41 @@ void add_parameters(const Json& result, Json& section) {
   if (result.contains("confidence_level") && result["confidence_level"].is_number()) {
     level = percent(result["confidence_level"]) + " confidence";
   }
-  section["charts"].push_back({{"title", "Parameters: " + level +
-                                             " intervals relative to |estimate| (green %σ < 5, "
-                                             "amber < 20, red ≥ 20 or undefined)"},
-                               {"type", "interval"},
-                               {"x_label", "interval / |estimate|"},
-                               {"labels", labels},
-                               {"low", low},
-                               {"high", high},
-                               {"value", value},
-                               {"colors", colors},
-                               {"tips", tips},
-                               {"wide", true}});
-  section["tables"].push_back({{"title", "Parameters"}, {"columns", columns}, {"rows", rows}});
+  // What an engineer reads first: the values with units and intervals, open above the charts.
+  section["tables"].push_back({{"title", "Parameters (" + level + " intervals)"},
+                               {"columns", columns},
+                               {"rows", rows},
+                               {"open", true}});
+  if (std::any_of(sigma.begin(), sigma.end(), [](const Json& x) { return x.is_number(); }))
+    section["charts"].push_back({{"title",
+                                  "Relative standard deviation %σ of every parameter (log "
+                                  "axis; green < 5, amber < 20, red ≥ 20)"},
+                                 {"type", "bar"},
+                                 {"y_label", "%σ"},
+                                 {"log", true},
+                                 {"labels", all_labels},
+                                 {"colors", sigma_colors},
+                                 {"series", {{{"label", "%σ"}, {"y", sigma}, {"kind", "bar"}}}},
+                                 {"wide", true}});
+  if (!labels.empty()) {
+    section["charts"].push_back(
+        {{"title", "The " + std::to_string(labels.size()) + " parameters within 20 %σ: " + level +
+                       " intervals relative to |estimate|"},
+         {"type", "interval"},
+         {"x_label", "interval / |estimate|"},
+         {"labels", labels},
+         {"low", low},
+         {"high", high},
+         {"value", value},
+         {"colors", colors},
+         {"tips", tips},
+         {"wide", true}});
+  }
+  if (!wide.empty()) {
+    std::string list;
+    for (const auto& name : wide) list += (list.empty() ? "" : ", ") + name;
+    section["facts"].push_back({"%σ ≥ 20 (not drawn as intervals; values in the table)", list});
+  }
 }
 
 // Per-joint bar chart of one array of the result (residual RMS, relative error).
@@ -687,8 +722,10 @@ constexpr const char* kRenderer = R"JS(
         datasets.push(s.kind === 'line'
           ? {type: 'line', label: s.label, data: s.y, pointRadius: 0, borderColor: '#d62728',
              borderWidth: 2, backgroundColor: '#d62728'}
-          : {type: 'bar', label: s.label, data: s.y, backgroundColor: col + 'b0'});
+          : {type: 'bar', label: s.label, data: s.y,
+             backgroundColor: c.colors ? c.colors : col + 'b0'});
       });
+      if (c.log) { scales.y.type = 'logarithmic'; scales.x.ticks = {autoSkip: false, font: {size: 9}}; }
       return {n: n, cfg: {type: 'bar', data: {labels: c.labels, datasets: datasets}, options: options}};
     }
     if (c.type === 'interval') {
@@ -733,6 +770,18 @@ constexpr const char* kRenderer = R"JS(
         sec.warnings.forEach(function (w) { ul.appendChild(el('li', '', w)); });
         root.appendChild(ul);
       }
+      function table(tab) {
+        var d = el('details'); d.appendChild(el('summary', '', tab.title));
+        if (tab.open) d.open = true;
+        var t = el('table'), h = el('tr');
+        tab.columns.forEach(function (c) { h.appendChild(el('th', '', c)); });
+        t.appendChild(h);
+        tab.rows.forEach(function (row) {
+          var r = el('tr'); row.forEach(function (v) { r.appendChild(el('td', '', v)); }); t.appendChild(r);
+        });
+        d.appendChild(t); root.appendChild(d);
+      }
+      sec.tables.forEach(function (tab) { if (tab.open) table(tab); });
       var grid = el('div', 'grid');
       root.appendChild(grid);
       sec.charts.forEach(function (c) {
@@ -748,16 +797,7 @@ constexpr const char* kRenderer = R"JS(
           new Chart(canvas, made.cfg);
         } catch (e) { errors++; console.error(e); }
       });
-      sec.tables.forEach(function (tab) {
-        var d = el('details'); d.appendChild(el('summary', '', tab.title));
-        var t = el('table'), h = el('tr');
-        tab.columns.forEach(function (c) { h.appendChild(el('th', '', c)); });
-        t.appendChild(h);
-        tab.rows.forEach(function (row) {
-          var r = el('tr'); row.forEach(function (v) { r.appendChild(el('td', '', v)); }); t.appendChild(r);
-        });
-        d.appendChild(t); root.appendChild(d);
-      });
+      sec.tables.forEach(function (tab) { if (!tab.open) table(tab); });
       root.dataset.charts = own; root.dataset.emptyCharts = ownEmpty;
     });
   }

@@ -15,6 +15,7 @@
 #include "dynid/io/csv_writer.hpp"
 #include "dynid/io/json_writer.hpp"
 #include "dynid/io/model_summary.hpp"
+#include "dynid/regressor/parameter_layout.hpp"
 #include "dynid/version.hpp"
 
 namespace dynid {
@@ -91,7 +92,8 @@ nlohmann::json identification_to_json(const Model& model, const IdentificationRe
                       {"relative_std_percent", json_number(e.relative_std_percent[k])},
                       {"ci_low", json_number(e.ci_lower[k])},
                       {"ci_high", json_number(e.ci_upper[k])},
-                      {"expression", r.expressions[i]}});
+                      {"expression", r.expressions[i]},
+                      {"unit", parameter_unit(model, r.names[i])}});
     // A data regrouping's name (Fc2R) is what the user reads; the base parameter it extends is
     // what validate, export and the completion look up.
     if (reported_name(r, i) != r.names[i]) params.back()["base_name"] = r.names[i];
