@@ -231,10 +231,12 @@ def test_excite_fourier_as_the_command_line(planar2, tmp_path):
     np.testing.assert_allclose((t["q"][2:] - t["q"][:-2]) / (2 * h), t["dq"][1:-1], atol=2e-3)
 
 
-def test_gravity_experiment_from_an_excited_and_simulated_slope_as_the_command_line(
+def test_one_joint_experiments_from_excited_and_simulated_runs_as_the_command_line(
         planar2, tmp_path):
-    """excite(family='slope') -> simulate -> identify(equations='gravity'), each step against
-    the command line; the fitted gravity torque of the shoulder against the closed form."""
+    """excite(family='slope') -> simulate -> identify(equations='gravity'), then 'decoupled' on
+    the same run and 'friction' on bang-bang moves compensated with that gravity result, each
+    step against the command line; the fitted gravity torque of the shoulder against the closed
+    form, and the (absent) friction inside its intervals."""
     slope = dict(family="slope", joint=1, range=(-1.0, 1.0), velocity=0.4, acceleration=2.0,
                  cycles=2, rate=500)
     reference = dynid.excite(planar2, **slope)["trajectory"]
@@ -262,6 +264,29 @@ def test_gravity_experiment_from_an_excited_and_simulated_slope_as_the_command_l
     closed_form = planar2_torques(np.column_stack([q1, np.zeros(5)]), rest, rest)[:, 0]
     fitted = values["k1"] * np.sin(q1 + values["qoff1"])
     np.testing.assert_allclose(fitted, closed_form, rtol=0.02, atol=0.05)
+
+    # The decoupled model of the same run (one joint moving, the other held).
+    decoupled = dynid.identify(planar2, run["t"], run["q"], run["tau"], equations="decoupled",
+                               joint=1)
+    decoupled_out = tmp_path / "decoupled.json"
+    cli("identify", "--robot", "planar2", "--data", logged, "--model", "decoupled", "--joint", 1,
+        "--out", decoupled_out)
+    assert_same(decoupled, json.loads(decoupled_out.read_text()), skip=(".options",))
+
+    # Friction from bang-bang moves, compensated with the gravity just identified (seed 2's
+    # chain: --params gravity.json, here the dict). planar2 has no friction: the truth is 0.
+    moves = dynid.excite(planar2, family="bang-bang", joint=1, range=(-1.0, 1.0),
+                         acceleration=3.0, cycles=2, rate=500)["trajectory"]
+    run = dynid.simulate(planar2, moves["t"], moves["q"], dq=moves["dq"], ddq=moves["ddq"],
+                         periods=1, torque_noise=0.02, seed=6)
+    logged = write_csv(tmp_path / "friction_run.csv", run["columns"], run["data"])
+    friction = dynid.identify(planar2, run["t"], run["q"], run["tau"], equations="friction",
+                              joint=1, params=ours)
+    friction_out = tmp_path / "friction.json"
+    cli("identify", "--robot", "planar2", "--data", logged, "--model", "friction", "--joint", 1,
+        "--params", out, "--out", friction_out)
+    assert_same(friction, json.loads(friction_out.read_text()), skip=(".options",))
+    assert_truth_inside(friction, {"Fvp1": 0.0, "Fvn1": 0.0, "Fcp1": 0.0, "Fcn1": 0.0})
 
 
 def test_bad_options_name_the_keyword(planar2):
