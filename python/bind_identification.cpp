@@ -11,6 +11,7 @@
 
 #include "binding.hpp"
 #include "dynid/common/error.hpp"
+#include "dynid/identification/known_friction.hpp"
 #include "dynid/identification/option_text.hpp"
 #include "dynid/io/closed_loop_file.hpp"
 #include "dynid/workflow/identify_runs.hpp"
@@ -19,9 +20,10 @@ namespace dynid::binding {
 namespace {
 
 // identify()'s keywords beyond validate()'s, each the command line's flag of the same name.
-const char* const kIdentifyOnly[] = {"physical",    "equations", "interval", "long_integrals",
-                                     "closed_loop", "fir",       "period",   "f0",
-                                     "noise_std",   "repeat",    "joint",    "params"};
+const char* const kIdentifyOnly[] = {
+    "friction_known", "outliers",    "physical", "equations", "interval",
+    "long_integrals", "closed_loop", "fir",      "period",    "f0",
+    "noise_std",      "repeat",      "joint",    "params"};
 
 // The flags of the library's messages as identify()'s keywords.
 const std::initializer_list<std::pair<const char*, const char*>> kIdentifyFlags = {
@@ -92,6 +94,16 @@ py::object identify_python(const Model& model, const std::vector<JointRecord>& r
   nlohmann::json out;
   try {
     if (!ik.noise_std.empty()) options.noise = parse_noise_std(ik.noise_std, model.dof());
+    if (kw.contains("friction_known")) {
+      if (ik.equations != "differential")
+        throw py::value_error("friction_known is for equations='differential'");
+      const py::list known = kw["friction_known"].cast<py::list>();
+      for (size_t i = 0; i < known.size(); ++i) {
+        const std::string name = "friction_known[" + std::to_string(i) + "]";
+        const IdentifiedResultFile f = identified_result(model, known[i].cast<py::dict>(), name);
+        add_known_friction(options.known_friction, model, f.names, f.values, name);
+      }
+    }
     if (ik.equations == "gravity" || ik.equations == "friction" || ik.equations == "decoupled") {
       if (options.estimator != IdentificationEstimator::kOls)
         throw py::value_error("equations='" + ik.equations +
@@ -173,11 +185,12 @@ void raise_with_keywords(const std::exception& e,
 IdentifyOptions identify_options(const py::kwargs& kw, nlohmann::json& used,
                                  IdentifyKeywords* identify) {
   static const char* const kKeys[] = {
-      "armature",      "viscous",   "coulomb",  "offset",    "asymmetric", "estimator",
-      "confidence",    "cutoff_hz", "filter",   "decimate",  "time_shift", "trim",
-      "zero_velocity", "savgol",    "physical", "equations", "interval",   "long_integrals",
-      "closed_loop",   "fir",       "period",   "f0",        "noise_std",  "repeat",
-      "joint",         "params"};
+      "armature",   "viscous",    "coulomb",        "offset",        "asymmetric",
+      "estimator",  "confidence", "cutoff_hz",      "filter",        "decimate",
+      "time_shift", "trim",       "zero_velocity",  "savgol",        "physical",
+      "equations",  "interval",   "long_integrals", "closed_loop",   "fir",
+      "period",     "f0",         "noise_std",      "repeat",        "joint",
+      "params",     "outliers",   "filter_coulomb", "coulomb_width", "friction_known"};
   check_keywords(kw, kKeys);
   if (!identify) {
     for (const char* key : kIdentifyOnly)
@@ -226,7 +239,27 @@ IdentifyOptions identify_options(const py::kwargs& kw, nlohmann::json& used,
         kw["zero_velocity"].cast<std::vector<double>>();
   if (kw.contains("savgol"))
     used["savitzky_golay"] = o.signal.savitzky_golay = kw["savgol"].cast<bool>();
+  if (kw.contains("filter_coulomb"))
+    used["filter_coulomb_columns"] = o.signal.filter_coulomb_columns =
+        kw["filter_coulomb"].cast<bool>();
+  if (kw.contains("coulomb_width"))
+    used["coulomb_width"] = o.signal.coulomb_width =
+        kw["coulomb_width"].cast<std::vector<double>>();
   if (!identify) return o;
+
+  const std::string outliers = get("outliers", std::string("report"));
+  if (outliers != "report" && outliers != "drop")
+    throw py::value_error("outliers must be 'report' or 'drop', not '" + outliers + "'");
+  o.outliers.policy = outliers == "drop" ? OutlierPolicy::kDrop : OutlierPolicy::kReport;
+  if (kw.contains("friction_known")) {
+    // Only the rigid body (and armature) is estimated (seed 2 §3.4): the friction columns go.
+    for (const char* key : {"viscous", "coulomb", "offset", "asymmetric"})
+      if (kw.contains(key) && kw[key].cast<bool>())
+        throw py::value_error(std::string("friction_known replaces the friction columns; drop ") +
+                              key);
+    o.layout = layout_of(o.layout.armature, false, false, false, false);
+    for (const char* key : {"viscous", "coulomb", "offset", "asymmetric"}) used[key] = false;
+  }
 
   identify->physical = get("physical", false);
   identify->equations = get("equations", std::string("differential"));
@@ -317,7 +350,10 @@ void bind_identification(py::module_& m) {
       "('ols', 'wls', 'rls', or 'ml': maximum likelihood with noisy q and tau, noise_std "
       "'q=S,tau=S' or estimated), confidence (0.999), cutoff_hz (0 = automatic), filter (bool, or "
       "the --filter text: 'none', 'butterworth:4', 'chebyshev:8:0.5'), decimate (0 = automatic), "
-      "trim, zero_velocity (list, rad/s), savgol (bool), time_shift (s: the torque sampled at t "
+      "trim, zero_velocity (list, rad/s), savgol (bool), filter_coulomb (bool), coulomb_width "
+      "(list, rad/s), outliers ('report' or 'drop'), friction_known (list of friction or "
+      "decoupled experiment results: their friction subtracted, only the rigid body "
+      "estimated), time_shift (s: the torque sampled at t "
       "acts at t + time_shift), equations ('differential', 'integral' with interval [s] and "
       "long_integrals, or a one-joint experiment 'gravity', 'friction', 'decoupled' with joint "
       "(1-based) and for friction params, an identify result compensating inertia and gravity), "

@@ -232,7 +232,7 @@ def test_excite_fourier_as_the_command_line(planar2, tmp_path):
 
 
 def test_one_joint_experiments_from_excited_and_simulated_runs_as_the_command_line(
-        planar2, tmp_path):
+        planar2, closed_loop_run, tmp_path):
     """excite(family='slope') -> simulate -> identify(equations='gravity'), then 'decoupled' on
     the same run and 'friction' on bang-bang moves compensated with that gravity result, each
     step against the command line; the fitted gravity torque of the shoulder against the closed
@@ -288,6 +288,17 @@ def test_one_joint_experiments_from_excited_and_simulated_runs_as_the_command_li
     assert_same(friction, json.loads(friction_out.read_text()), skip=(".options",))
     assert_truth_inside(friction, {"Fvp1": 0.0, "Fvn1": 0.0, "Fcp1": 0.0, "Fcn1": 0.0})
 
+    # That friction known, the rigid body of a whole-arm run (seed 2 §3.4: --friction-known).
+    _, _, steady, steady_path = closed_loop_run
+    rigid = dynid.identify(planar2, steady["t"], steady["q"], steady["tau"],
+                           friction_known=[friction], armature=False)
+    rigid_out = tmp_path / "rigid.json"
+    cli("identify", "--robot", "planar2", "--data", steady_path, "--friction-known",
+        friction_out, "--no-armature", "--out", rigid_out)
+    assert_same(rigid, json.loads(rigid_out.read_text()), skip=(".options",) + run_files(1))
+    assert [k["name"] for k in rigid["options"]["known_friction"]] == ["Fvp1", "Fvn1", "Fcp1",
+                                                                      "Fcn1"]
+
 
 def test_bad_options_name_the_keyword(planar2):
     t, q, dq, ddq = fourier_run(40, samples=300)
@@ -318,6 +329,10 @@ def test_bad_options_name_the_keyword(planar2):
         dynid.average(t, {"q1": q[:, 0]})
     with pytest.raises(dynid.Error, match="cutoff_hz"):
         dynid.average(t, {"q1": q[:, 0]}, period=1.0, filter="butterworth:4")
+    with pytest.raises(ValueError, match="friction_known replaces the friction columns"):
+        dynid.identify(planar2, t, q, tau, friction_known=[{}], viscous=True)
+    with pytest.raises(ValueError, match="outliers must be"):
+        dynid.identify(planar2, t, q, tau, outliers="keep")
     with pytest.raises(ValueError, match="controller='computed-torque' needs params"):
         dynid.simulate(planar2, t, q, controller="computed-torque")
 
