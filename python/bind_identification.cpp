@@ -21,9 +21,9 @@ namespace {
 
 // identify()'s keywords beyond validate()'s, each the command line's flag of the same name.
 const char* const kIdentifyOnly[] = {
-    "friction_known", "outliers",    "physical", "equations", "interval",
-    "long_integrals", "closed_loop", "fir",      "period",    "f0",
-    "noise_std",      "repeat",      "joint",    "params"};
+    "friction_known", "outliers",    "noise", "physical", "equations", "interval",
+    "long_integrals", "closed_loop", "fir",   "period",   "f0",        "noise_std",
+    "repeat",         "joint",       "params"};
 
 // The flags of the library's messages as identify()'s keywords.
 const std::initializer_list<std::pair<const char*, const char*>> kIdentifyFlags = {
@@ -84,6 +84,29 @@ std::pair<JointRecord, ReferenceRecord> run_of(const Model& model, const py::han
   return {record, reference};
 }
 
+// The `noise` keyword: an average() result (or the command line's average --json, loaded),
+// as identify --noise reads the file: std_averaged when the first run is that result's mean
+// period (the same times), else std, the raw per-sample noise.
+SensorNoise sensor_noise_of(const Model& model, const std::vector<JointRecord>& runs,
+                            const py::handle& noise, nlohmann::json& used) {
+  if (!py::isinstance<py::dict>(noise))
+    throw py::type_error("noise must be the dict of dynid.average (or of average --json)");
+  const py::dict d = py::reinterpret_borrow<py::dict>(noise);
+  bool averaged = false;
+  if (d.contains("mean") && !runs.empty()) {
+    const RowMatrix mean = d["mean"].cast<RowMatrix>();
+    const Eigen::VectorXd& t = runs.front().t;
+    averaged = mean.cols() > 0 && mean.rows() == t.size() && mean.col(0) == t;
+  }
+  nlohmann::json j = nlohmann::json::object();
+  if (d.contains("channels")) {
+    j["channels"] = nlohmann::json::parse(
+        py::module_::import("json").attr("dumps")(d["channels"]).cast<std::string>());
+  }
+  used["noise"] = averaged ? "std_averaged of the mean period" : "std, the raw per-sample noise";
+  return sensor_noise_from_json(j, model, averaged, "noise");
+}
+
 // identify() of runs as `dynid identify --data R1 --data R2 ...` with the keywords as its flags.
 py::object identify_python(const Model& model, const std::vector<JointRecord>& runs,
                            const std::vector<ReferenceRecord>& references, const py::kwargs& kw) {
@@ -94,6 +117,7 @@ py::object identify_python(const Model& model, const std::vector<JointRecord>& r
   nlohmann::json out;
   try {
     if (!ik.noise_std.empty()) options.noise = parse_noise_std(ik.noise_std, model.dof());
+    if (kw.contains("noise")) options.noise = sensor_noise_of(model, runs, kw["noise"], used);
     if (kw.contains("friction_known")) {
       if (ik.equations != "differential")
         throw py::value_error("friction_known is for equations='differential'");
@@ -190,7 +214,8 @@ IdentifyOptions identify_options(const py::kwargs& kw, nlohmann::json& used,
       "time_shift", "trim",       "zero_velocity",  "savgol",        "physical",
       "equations",  "interval",   "long_integrals", "closed_loop",   "fir",
       "period",     "f0",         "noise_std",      "repeat",        "joint",
-      "params",     "outliers",   "filter_coulomb", "coulomb_width", "friction_known"};
+      "params",     "outliers",   "filter_coulomb", "coulomb_width", "friction_known",
+      "noise"};
   check_keywords(kw, kKeys);
   if (!identify) {
     for (const char* key : kIdentifyOnly)
@@ -307,10 +332,13 @@ IdentifyOptions identify_options(const py::kwargs& kw, nlohmann::json& used,
       throw py::value_error("give one of period (s) or f0 (Hz), > 0");
     o.closed_loop.period = period > 0.0 ? period : 1.0 / f0;
   }
-  if (kw.contains("noise_std")) {
+  if (kw.contains("noise_std") || kw.contains("noise")) {
     if (o.estimator != IdentificationEstimator::kMl)
-      throw py::value_error("noise_std is the noise of estimator='ml'; add it or drop noise_std");
-    identify->noise_std = get("noise_std", std::string());
+      throw py::value_error(
+          "noise and noise_std are the noise of estimator='ml'; add it or drop them");
+    if (kw.contains("noise_std") && kw.contains("noise"))
+      throw py::value_error("give noise (an average() result) or noise_std, not both");
+    if (kw.contains("noise_std")) identify->noise_std = get("noise_std", std::string());
   }
   identify->repeat = kw.contains("repeat") ? get("repeat", std::string()) : std::string();
   if (!identify->repeat.empty() && identify->repeat != "periods" && identify->repeat != "runs")
@@ -348,7 +376,9 @@ void bind_identification(py::module_& m) {
       "closed-loop run the reference qr (optional dqr, ddqr). Options (the command line's flags): "
       "armature, viscous, coulomb, offset, asymmetric (bool: the per-joint columns), estimator "
       "('ols', 'wls', 'rls', or 'ml': maximum likelihood with noisy q and tau, noise_std "
-      "'q=S,tau=S' or estimated), confidence (0.999), cutoff_hz (0 = automatic), filter (bool, or "
+      "'q=S,tau=S', or noise: a dynid.average result, its std_averaged when the run is its mean "
+      "period, else its std; default estimated), confidence (0.999), cutoff_hz (0 = automatic), "
+      "filter (bool, or "
       "the --filter text: 'none', 'butterworth:4', 'chebyshev:8:0.5'), decimate (0 = automatic), "
       "trim, zero_velocity (list, rad/s), savgol (bool), filter_coulomb (bool), coulomb_width "
       "(list, rad/s), outliers ('report' or 'drop'), friction_known (list of friction or "

@@ -177,6 +177,33 @@ def test_closed_loop_projection_and_maximum_likelihood_as_the_command_line(
     assert_truth_inside(ml, truth)
 
 
+def test_maximum_likelihood_with_the_noise_average_measured_as_the_command_line(
+        planar2, closed_loop_run, tmp_path):
+    """identify --estimator ml --noise avg.json: the raw std for the run itself, std_averaged for
+    its mean period (seed 2 §3.4: average, then fit the mean)."""
+    _, _, run, path = closed_loop_run
+    names = ["qr1", "qr2", "q1", "q2", "tau1", "tau2"]
+    blocks = np.column_stack([run["qr"], run["q"], run["tau"]])
+    noise = dynid.average(run["t"], dict(zip(names, blocks.T)), period=2.0)
+    mean, noise_file = tmp_path / "mean.csv", tmp_path / "noise.json"
+    cli("average", "--data", path, "--period", 2, "--out", mean, "--json", noise_file)
+    for data, arrays in ((path, run), (mean, None)):
+        if arrays is None:  # the mean period: phase t, then the columns in `names` order
+            m = noise["mean"]
+            arrays = {"t": m[:, 0], "qr": m[:, 1:3], "q": m[:, 3:5], "tau": m[:, 5:7]}
+        ours = dynid.identify(planar2, arrays["t"], arrays["q"], arrays["tau"], estimator="ml",
+                              noise=noise, **NO_FRICTION)
+        out = tmp_path / "ml.json"
+        cli("identify", "--robot", "planar2", "--data", data, "--estimator", "ml", "--noise",
+            noise_file, *NO_FRICTION_FLAGS, "--out", out)
+        expected = json.loads(out.read_text())
+        which = expected["choices"].pop("noise_file")  # the file the command line read
+        assert_same(ours, expected, skip=(".options",) + run_files(1))
+        field = "std_averaged" if data == mean else "std"
+        assert which.startswith(f"{noise_file}: {field},")
+        assert ours["options"]["noise"].split(",")[0].split()[0] == field
+
+
 def test_repeated_estimates_over_periods_as_the_command_line(planar2, closed_loop_run, tmp_path):
     _, _, run, path = closed_loop_run
     ours = dynid.identify(planar2, run["t"], run["q"], run["tau"], qr=run["qr"],
@@ -311,7 +338,7 @@ def test_bad_options_name_the_keyword(planar2):
         dynid.identify(planar2, t, q, tau, fir=[2, 2])
     with pytest.raises(ValueError, match="needs joint=J"):
         dynid.identify(planar2, t, q, tau, equations="gravity")
-    with pytest.raises(ValueError, match="noise_std is the noise of estimator='ml'"):
+    with pytest.raises(ValueError, match="noise and noise_std are the noise of estimator='ml'"):
         dynid.identify(planar2, t, q, tau, noise_std="q=1e-4,tau=0.1")
     with pytest.raises(dynid.Error, match="noise_std"):
         dynid.identify(planar2, t, q, tau, estimator="ml", noise_std="q=-1")
