@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "binding.hpp"
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
 #include "dynid/dynamics/rnea.hpp"
@@ -37,11 +38,7 @@
 
 namespace py = pybind11;
 
-namespace dynid {
-namespace {
-
-using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-using Samples = Eigen::Ref<const RowMatrix>;
+namespace dynid::binding {
 
 py::object to_python(const nlohmann::json& j) {
   return py::module_::import("json").attr("loads")(j.dump());
@@ -67,24 +64,6 @@ void check_samples(const Model& model, const char* name, const RowMatrix::Index 
   if (!x.allFinite()) throw Error(std::string(name) + " holds NaN or Inf");
 }
 
-RowMatrix inverse_dynamics(const Model& model, const Samples& q, const Samples& dq,
-                           const Samples& ddq, bool joint_terms) {
-  check_samples(model, "q", q.rows(), q);
-  check_samples(model, "dq", q.rows(), dq);
-  check_samples(model, "ddq", q.rows(), ddq);
-  Workspace ws(model);
-  RowMatrix tau(q.rows(), model.dof());
-  Eigen::VectorXd out(model.dof());
-  RneaOptions options;
-  options.joint_terms = joint_terms;
-  for (Eigen::Index k = 0; k < q.rows(); ++k) {
-    rnea(model, ws, q.row(k).transpose(), dq.row(k).transpose(), ddq.row(k).transpose(), out,
-         options);
-    tau.row(k) = out.transpose();
-  }
-  return tau;
-}
-
 JointRecord record_of(const Model& model, const Eigen::VectorXd& t, const Samples& q,
                       const Samples& tau, const std::optional<RowMatrix>& dq,
                       const std::optional<RowMatrix>& ddq) {
@@ -105,69 +84,57 @@ JointRecord record_of(const Model& model, const Eigen::VectorXd& t, const Sample
   return r;
 }
 
-// identify()/validate() options from keyword arguments; an unknown key is an error naming the
-// valid ones.
-// The `estimator` keyword ('ols', 'wls' or 'rls') as identify's or payload's enum.
-template <class Estimator>
-Estimator estimator_of(const std::string& name, Estimator ols, Estimator wls, Estimator rls) {
-  if (name == "ols") return ols;
-  if (name == "wls") return wls;
-  if (name == "rls") return rls;
-  throw py::value_error("estimator must be 'ols', 'wls' or 'rls', not '" + name + "'");
-}
-
-// The `confidence` keyword, checked.
 double confidence_of(double level) {
   if (!(level > 0.0 && level < 1.0))
     throw py::value_error("confidence must be in (0, 1), e.g. 0.999");
   return level;
 }
 
-// Every keyword is one of `keys`, else a TypeError naming it and the valid ones.
-template <size_t N>
-void check_keywords(const py::kwargs& kw, const char* const (&keys)[N]) {
-  std::string valid;
-  for (const char* k : keys) valid += (valid.empty() ? "" : ", ") + std::string(k);
-  for (const auto& item : kw) {
-    const std::string key = py::str(item.first);
-    if (std::find_if(std::begin(keys), std::end(keys), [&](const char* k) { return key == k; }) ==
-        std::end(keys)) {
-      throw py::type_error("unknown option '" + key + "'; valid options are " + valid);
-    }
+IdentifiedResultFile identified_result(const Model& model, const py::dict& result,
+                                       const std::string& what) {
+  // allow_nan=False: a NaN or Inf value is refused here by name, as the command line refuses it,
+  // instead of reaching the JSON parser as the non-JSON token NaN.
+  std::string text;
+  try {
+    text = py::module_::import("json")
+               .attr("dumps")(result, py::arg("allow_nan") = false)
+               .cast<std::string>();
+  } catch (const py::error_already_set& e) {
+    throw Error("the " + what + " holds a value a result cannot have (" + one_line(e.what()) +
+                "); give finite numbers, as dynid.identify returns them");
   }
+  const nlohmann::json j = nlohmann::json::parse(text);
+  IdentifiedResultFile identified = identification_result_from_json(j, what);
+  if (!identified.robot.empty() && identified.robot != model.name) {
+    throw Error("the " + what + " is of robot '" + identified.robot + "', not '" + model.name +
+                "'; give a result of this robot");
+  }
+  return identified;
 }
 
-// `physical` (identify only): where to put identify's --physical, else that keyword is refused.
-IdentifyOptions identify_options(const py::kwargs& kw, nlohmann::json& used,
-                                 bool* physical = nullptr) {
-  static const char* const kKeys[] = {"armature",   "viscous",   "coulomb",    "offset",
-                                      "asymmetric", "estimator", "confidence", "cutoff_hz",
-                                      "filter",     "decimate",  "physical",   "time_shift"};
-  check_keywords(kw, kKeys);
-  if (!physical && kw.contains("physical")) {
-    throw py::type_error("physical is an option of identify(), not of validate()");
+}  // namespace dynid::binding
+
+namespace dynid {
+namespace {
+
+using namespace binding;
+
+RowMatrix inverse_dynamics(const Model& model, const Samples& q, const Samples& dq,
+                           const Samples& ddq, bool joint_terms) {
+  check_samples(model, "q", q.rows(), q);
+  check_samples(model, "dq", q.rows(), dq);
+  check_samples(model, "ddq", q.rows(), ddq);
+  Workspace ws(model);
+  RowMatrix tau(q.rows(), model.dof());
+  Eigen::VectorXd out(model.dof());
+  RneaOptions options;
+  options.joint_terms = joint_terms;
+  for (Eigen::Index k = 0; k < q.rows(); ++k) {
+    rnea(model, ws, q.row(k).transpose(), dq.row(k).transpose(), ddq.row(k).transpose(), out,
+         options);
+    tau.row(k) = out.transpose();
   }
-  auto get = [&](const char* key, auto fallback) {
-    using T = decltype(fallback);
-    const T value = kw.contains(key) ? kw[key].cast<T>() : fallback;
-    used[key] = value;
-    return value;
-  };
-  IdentifyOptions o;
-  o.layout = layout_of(get("armature", true), get("viscous", true), get("coulomb", true),
-                       get("offset", true), get("asymmetric", false));
-  o.estimator = estimator_of(get("estimator", std::string("ols")), IdentificationEstimator::kOls,
-                             IdentificationEstimator::kWls, IdentificationEstimator::kRls);
-  o.confidence_level = confidence_of(get("confidence", 0.999));
-  o.signal.cutoff_hz = get("cutoff_hz", 0.0);
-  o.signal.filter = get("filter", true);
-  o.signal.decimate = get("decimate", 0);
-  // identify's --time-shift, stored under the command line's key so that `dynid validate` and
-  // validate() of a stored result shift alike.
-  o.signal.torque_time_offset = kw.contains("time_shift") ? kw["time_shift"].cast<double>() : 0.0;
-  used["time_shift_s"] = o.signal.torque_time_offset;
-  if (physical) *physical = get("physical", false);
-  return o;
+  return tau;
 }
 
 // The load equations and estimator shared by the sensor modes of payload (`dynid payload`'s
@@ -206,14 +173,6 @@ LoadKeywords load_keywords(const Get& get) {
                                      LoadEstimator::kWls, LoadEstimator::kRls);
   k.options.confidence_level = confidence_of(get("confidence", 0.999));
   return k;
-}
-
-// A keyword's value or `fallback` (of the keyword's type).
-auto keyword_getter(const py::kwargs& kw) {
-  return [&kw](const char* key, auto fallback) {
-    using T = decltype(fallback);
-    return kw.contains(key) ? kw[key].cast<T>() : fallback;
-  };
 }
 
 // A pose keyword [x, y, z, roll, pitch, yaw] [m, rad] as (R, p), URDF roll-pitch-yaw.
@@ -379,31 +338,6 @@ IdentifyOptions options_of_result(const Model& model, const IdentifiedResultFile
   return options_of_stored_result(identified, "result", model.dof()).options;
 }
 
-// An identify result dict (dynid.identify's, or a result.json loaded with json.load) read with
-// the checks of read_identification_result; a result of another robot is an error, as on the
-// command line.
-IdentifiedResultFile identified_result(const Model& model, const py::dict& result,
-                                       const std::string& what) {
-  // allow_nan=False: a NaN or Inf value is refused here by name, as the command line refuses it,
-  // instead of reaching the JSON parser as the non-JSON token NaN.
-  std::string text;
-  try {
-    text = py::module_::import("json")
-               .attr("dumps")(result, py::arg("allow_nan") = false)
-               .cast<std::string>();
-  } catch (const py::error_already_set& e) {
-    throw Error("the " + what + " holds a value a result cannot have (" + one_line(e.what()) +
-                "); give finite numbers, as dynid.identify returns them");
-  }
-  const nlohmann::json j = nlohmann::json::parse(text);
-  IdentifiedResultFile identified = identification_result_from_json(j, what);
-  if (!identified.robot.empty() && identified.robot != model.name) {
-    throw Error("the " + what + " is of robot '" + identified.robot + "', not '" + model.name +
-                "'; give a result of this robot");
-  }
-  return identified;
-}
-
 // payload_from_torques(): a load without a sensor, as `dynid payload --robot R --link L
 // --reference unloaded.csv|result.json`.
 nlohmann::json payload_from_torques(const Model& model, const std::string& link_name,
@@ -524,6 +458,7 @@ nlohmann::json payload_from_torques(const Model& model, const std::string& link_
 // The compiled half of the Python package dynid (python/dynid/__init__.py re-exports it).
 PYBIND11_MODULE(_core, m) {
   using namespace dynid;
+  using namespace dynid::binding;
   m.doc() =
       "dynid: identification of robot dynamic parameters (link inertias, actuator inertias, joint "
       "friction). Units SI; parameter names and order as in dynid's docs/design.md section 3. "
@@ -652,53 +587,6 @@ PYBIND11_MODULE(_core, m) {
       "Base parameters theta_b = theta_1 + K_d theta_2 (numerical Gautier-Khalil): a dict with "
       "the keys of 'dynid model --base --json' (rank, base_parameters [{name, expression}], "
       "unidentifiable, samples) plus K_d, base_indices, dependent_indices and layout_names.");
-
-  m.def(
-      "identify",
-      [](const Model& model, const Eigen::VectorXd& t, const Samples& q, const Samples& tau,
-         const std::optional<RowMatrix>& dq, const std::optional<RowMatrix>& ddq,
-         const py::kwargs& kw) {
-        nlohmann::json used;
-        bool physical = false;
-        const IdentifyOptions options = identify_options(kw, used, &physical);
-        const JointRecord record = record_of(model, t, q, tau, dq, ddq);
-        py::gil_scoped_release release;
-        const IdentificationResult result = identify(model, record, options);
-        nlohmann::json out = identification_to_json(model, result, used);
-        // As the command line: the run replayed with the estimate (the `plot` a report draws,
-        // and the unconstrained torque error beside the consistent one), the RLS history.
-        IdentifyOptions same = options;
-        same.signal.cutoff_hz = result.processed.cutoff_hz;
-        std::optional<ValidationResult> replay;
-        try {
-          replay = validate_torques(model, record, result.names, result.estimate.x, same,
-                                    result.not_excited);
-          std::vector<std::string> joints;
-          for (const auto& joint : model.joints) joints.push_back(joint.name);
-          out["plot"] = prediction_plot_json(*replay, joints);
-        } catch (const Error&) {  // the result stands without its plot (e.g. nothing excited)
-        }
-        if (result.history_x.rows() > 0) out["plot"]["history"] = rls_history_plot_json(result);
-        if (physical) {
-          const PhysicalCheck c = physical_parameters_of_result(
-              model, result, options, record, "physical=True",
-              replay ? std::optional<double>(replay->relative_error_all) : std::nullopt);
-          physical_parameters_to_json(c.fit, c.physical_error, c.free_error, out, c.warnings);
-        }
-        py::gil_scoped_acquire acquire;
-        return to_python(out);
-      },
-      py::arg("model"), py::arg("t"), py::arg("q"), py::arg("tau"), py::arg("dq") = py::none(),
-      py::arg("ddq") = py::none(),
-      "Identifies base parameters with their uncertainty from one run, as 'dynid identify': t "
-      "(m,) [s], q and tau (m x n), optional dq, ddq (derived from q when absent). Options: "
-      "armature, viscous, coulomb, offset, asymmetric (bool: the per-joint columns), estimator "
-      "('ols', 'wls', 'rls'), confidence (0.999), cutoff_hz (0 = automatic), filter (bool), "
-      "decimate (0 = automatic), time_shift (s, --time-shift: the torque sampled at t acts at "
-      "t + time_shift), physical (bool, --physical: also physically consistent standard "
-      "parameters, log-Cholesky fit of C. Rucker, P. M. Wensing, 2022, for export_urdf). Returns "
-      "a dict with the keys of the result JSON (parameters, condition_number, residual_rms, "
-      "plot, and with physical standard_parameters, physically_consistent, physical).");
 
   m.def(
       "validate",
@@ -831,4 +719,7 @@ PYBIND11_MODULE(_core, m) {
       py::arg("model"), py::arg("result"), py::arg("path"),
       "Writes the standard_parameters of an 'identify --physical' result as URDF, as 'dynid "
       "export'; returns the identified terms the URDF cannot hold.");
+  // One function per binding area, each in its own translation unit (python/bind_*.cpp).
+  bind_identification(m);
+  bind_experiments(m);
 }

@@ -19,6 +19,7 @@
 #include "dynid/io/json_writer.hpp"
 #include "dynid/signal/period_averaging.hpp"
 #include "dynid/signal/periodic_filter.hpp"
+#include "dynid/workflow/average_run.hpp"
 #include "run_flags.hpp"
 
 namespace dynid::cli {
@@ -37,23 +38,16 @@ struct AverageCliOptions {
 void run(const AverageCliOptions& o, const CLI::App& cmd) {
   if ((o.period > 0.0) == (o.f0 > 0.0))
     throw UsageError("give exactly one of --period S or --f0 HZ (> 0)");
-  if (o.skip_periods < 0) throw UsageError("--skip-periods must be >= 0");
-  const double period = o.period > 0.0 ? o.period : 1.0 / o.f0;
-  SignalOptions filter;
-  apply_filter_text(o.filter, filter);
+  AverageRunOptions options;
+  options.period = o.period > 0.0 ? o.period : 1.0 / o.f0;
+  options.start = o.start;
+  options.skip_periods = o.skip_periods;
+  options.filter = o.filter;
+  options.cutoff_hz = o.cutoff;
+  options.decimate = o.decimate;
+  check_average_run_options(options);  // before the file is read
+  const double period = options.period;
   const bool filtered = o.filter != "none";
-  if (o.filter == "auto")
-    throw UsageError(
-        "--filter auto chooses identify's cut-off from a run; for the averaged period name the "
-        "filter (butterworth[:ORDER] or chebyshev[:ORDER[:RIPPLE_DB]]) and give --cutoff HZ");
-  if (filtered && !(o.cutoff > 0.0))
-    throw UsageError("--filter " + o.filter + " needs --cutoff HZ (> 0), e.g. --cutoff 80");
-  if (!filtered && o.cutoff != 0.0)
-    throw UsageError("--cutoff sets the low-pass of --filter: give --filter too, e.g. chebyshev:8");
-  if (o.decimate < 1) throw UsageError("--decimate must be >= 1");
-  if (!filtered && o.decimate > 1)
-    throw UsageError("--decimate " + std::to_string(o.decimate) +
-                     " needs a low-pass against aliasing: give --filter and --cutoff too");
   if (run_flag_given(cmd, "--time-shift")) {
     std::cerr << "warning: --time-shift has no effect on dynid average (the columns are averaged "
                  "as logged); give it to identify, which reads the averaged period\n";
@@ -78,84 +72,14 @@ void run(const AverageCliOptions& o, const CLI::App& cmd) {
   if (cols.empty()) throw Error(o.data + " has no column besides t: nothing to average");
   Eigen::MatrixXd x(table.data.rows(), static_cast<Eigen::Index>(cols.size()));
   for (Eigen::Index j = 0; j < x.cols(); ++j) x.col(j) = table.data.col(cols[j]);
-  TimedPeriodAverageOptions options;
-  options.start = o.start;
-  options.skip_periods = o.skip_periods;
-  const TimedPeriodAverage a = average_periods_in_time(run.t, x, period, options);
-  const std::vector<std::string> warnings = check_period_repeats(a, x, names);
-
-  // Seed 2 section 3.4: averaged, then low-passed (8th-order Chebyshev at 80 Hz) and resampled
-  // (200 Hz). The mean is one period of a periodic signal, so the zero-phase filter is circular:
-  // no edge transient, nothing trimmed. Averaging and filtering are both linear, so their order
-  // does not matter. The noise statistics are those of the raw samples (std) and of the mean
-  // period written (std_averaged, what identify --estimator ml needs when it fits the mean).
-  PeriodicLowpassOptions lowpass;
-  lowpass.design.family = filter.family;
-  lowpass.design.order = filter.order;
-  lowpass.design.ripple_db = filter.ripple_db;
-  lowpass.design.cutoff_hz = o.cutoff;
-  lowpass.design.sample_rate_hz = 1.0 / (period / static_cast<double>(a.mean.rows()));
-  lowpass.decimate = o.decimate;
-  std::vector<Eigen::Index> measured;  // columns filtered (every one but the reference's)
-  for (Eigen::Index c = 0; c < a.mean.cols(); ++c)
-    if (!is_reference_channel(names[static_cast<size_t>(c)])) measured.push_back(c);
-  Eigen::MatrixXd kept = a.mean;
-  Eigen::VectorXd phase = a.phase;
-  if (filtered) {
-    LowpassedPeriod f = lowpass_period_columns(lowpass, a.phase, a.mean, measured);
-    kept = std::move(f.x);
-    phase = std::move(f.phase);
-  }
-
-  std::vector<std::string> header = {"t"};
-  header.insert(header.end(), names.begin(), names.end());
-  Eigen::MatrixXd mean(kept.rows(), kept.cols() + 1);
-  mean << phase, kept;
-  nlohmann::json j;
-  if (!o.json.empty()) {
-    j["data"] = o.data;
-    j["out"] = o.out;
-    j["period"] = period;
-    j["sample_time"] = a.sample_time;
-    j["samples_per_period"] = a.samples_per_period;
-    j["interpolated"] = a.interpolated;
-    j["start"] = a.start;
-    j["periods"] = a.periods;
-    j["skipped_periods"] = o.skip_periods;
-    j["samples_before"] = a.samples_before;
-    j["samples_after"] = a.samples_after;
-    j["partial_period"] = a.partial_period;
-    j["residual_samples"] = a.residual_samples;
-    j["warnings"] = warnings;
-    if (filtered) {
-      nlohmann::json unfiltered = nlohmann::json::array();
-      for (const std::string& name : names)
-        if (is_reference_channel(name)) unfiltered.push_back(name);
-      j["filter"] = {
-          {"family", filter.family == LowpassFamily::kChebyshev1 ? "chebyshev" : "butterworth"},
-          {"order", filter.order},
-          {"ripple_db", filter.family == LowpassFamily::kChebyshev1 ? json_number(filter.ripple_db)
-                                                                    : nlohmann::json()},
-          {"cutoff_hz", o.cutoff},
-          {"decimate", o.decimate},
-          {"rate_hz", lowpass.design.sample_rate_hz / o.decimate},
-          {"rows", kept.rows()},
-          {"unfiltered", unfiltered}};
-    }
-    j["channels"] = nlohmann::json::array();
-    for (std::size_t c = 0; c < names.size(); ++c) {
-      const ChannelNoise& ch = a.channels[c];
-      j["channels"].push_back(
-          {{"name", names[c]},
-           {"std", ch.std},
-           {"std_averaged", averaged_noise_std(ch.std, a.periods, filtered ? &lowpass : nullptr)},
-           {"skewness", json_number(ch.skewness)},
-           {"kurtosis", json_number(ch.kurtosis)},
-           {"normality_p", json_number(ch.normality_p)}});
-    }
-  }
+  const AveragedRun averaged = average_run(run.t, x, names, options);
+  const TimedPeriodAverage& a = averaged.average;
+  const std::vector<std::string>& warnings = averaged.warnings;
+  nlohmann::json j = averaged.json;
+  j["data"] = o.data;
+  j["out"] = o.out;
   for (const std::string& w : warnings) std::cerr << "warning: " << w << '\n';
-  write_csv(o.out, header, mean);
+  write_csv(o.out, averaged.columns, averaged.mean);
   if (!o.json.empty()) write_json(o.json, j);
   std::cout << "averaged " << a.periods << " periods of " << short_number(period) << " s ("
             << short_number(a.samples_per_period) << " samples"
@@ -165,8 +89,8 @@ void run(const AverageCliOptions& o, const CLI::App& cmd) {
     std::cout << "filtered the mean period circularly (" << o.filter << ", zero phase, cut-off "
               << short_number(o.cutoff) << " Hz)"
               << (o.decimate > 1 ? ", kept every " + std::to_string(o.decimate) + "th sample (" +
-                                       short_number(lowpass.design.sample_rate_hz / o.decimate) +
-                                       " Hz, " + std::to_string(kept.rows()) + " rows)"
+                                       short_number(averaged.rate_hz) + " Hz, " +
+                                       std::to_string(averaged.mean.rows()) + " rows)"
                                  : std::string())
               << "; reference columns (qr*, dqr*, ddqr*) left as logged\n";
   if (a.samples_after > 0)

@@ -38,6 +38,7 @@
 #include "dynid/report/stored_result.hpp"
 #include "dynid/sim/pid_gains.hpp"
 #include "dynid/sim/simulate_reference.hpp"
+#include "dynid/workflow/identify_runs.hpp"
 #include "flag_checks.hpp"
 #include "robot_flags.hpp"
 #include "run_flags.hpp"
@@ -304,12 +305,6 @@ void warn_identify_no_effect(const IdentifyCliOptions& o, const CLI::App& cmd) {
     if (cmd.count(flag)) warn(std::string(flag) + " has no effect with --closed-loop" + why);
 }
 
-// The model whose rigid-body and armature torques a friction experiment subtracts: the robot's
-// nominal one, or the one identified in `params` (its base parameters, the rest nominal).
-Model compensation_model(const Model& model, const std::string& params) {
-  return completed_model_from_result(model, params, "identify").model;
-}
-
 }  // namespace
 
 CompletedModel completed_model_from_result(const Model& model, const std::string& params,
@@ -337,62 +332,26 @@ void run_experiment(const IdentifyCliOptions& o, const IdentifyOptions& options,
   }
   const Model model = load_cli_robot(o.robot, o.robot_flags,
                                      {"identify", o.runs, file.columns, {}, "", file.topic});
-  if (o.joint < 1 || o.joint > model.dof()) {
-    throw UsageError("--joint " + std::to_string(o.joint) + " is not a joint of '" + model.name +
-                     "'; give 1 to " + std::to_string(model.dof()));
-  }
   if (!o.params.empty()) require_readable(o.params, "--params");
   RunFileReport read;
-  std::vector<ProcessedRecord> runs;
-  std::vector<std::pair<std::string, std::string>> choices;
-  for (const auto& path : o.runs) {
-    const JointRecord record = read_joint_record(path, model, file, &read);
-    if (record.q.cols() != model.dof()) {
-      throw Error("'" + path + "' has " + std::to_string(record.q.cols()) + " joints but model '" +
-                  model.name + "' has " + std::to_string(model.dof()));
-    }
-    runs.push_back(preprocess(record, options.signal, choices));
-  }
-  const int j = o.joint - 1;
+  std::vector<JointRecord> runs;
+  for (const auto& path : o.runs) runs.push_back(read_joint_record(path, model, file, &read));
   nlohmann::json used = echo(o);
   used["joint"] = o.joint;
   used["data_runs"] = o.runs;
-  nlohmann::json result;
-  if (o.model == "gravity") {
-    GravityExperimentOptions go;
-    go.confidence_level = options.confidence_level;
-    if (count_distinct_poses(runs, j, go) > 1) {  // the general form: gravity of J over all q
-      GravityPosesResult r = fit_gravity_poses(model, runs, j, go);
-      r.choices.insert(r.choices.begin(), choices.begin(), choices.end());
-      result = gravity_poses_to_json(model, r, used);
-    } else {
-      GravityExperimentResult r = fit_gravity_experiment(runs, j, go);
-      r.choices.insert(r.choices.begin(), choices.begin(), choices.end());
-      result = gravity_experiment_to_json(model, r, used);
-    }
-  } else if (o.model == "friction") {
-    FrictionExperimentOptions fo;
-    fo.confidence_level = options.confidence_level;
-    Model compensation = model;
-    if (!o.params.empty()) {
-      const IdentifiedResultFile f = read_identification_result(o.params);
-      require_same_robot(f.robot, model.name, "'" + o.params + "'", "give a result of this robot");
-      // A gravity or decoupled result compensates the gravity (and inertia) of this joint
-      // (Bona & Curatella's chain); a base-parameter result the whole rigid body.
-      add_stored_friction_compensation(model, f, o.params, j, fo);
-      if (f.experiment.empty()) compensation = compensation_model(model, o.params);
-    }
-    FrictionExperimentResult r = fit_friction_experiment(compensation, runs, j, fo);
-    r.choices.insert(r.choices.begin(), choices.begin(), choices.end());
-    result = friction_experiment_to_json(model, r, used);
-  } else {
-    DecoupledModelOptions dm;
-    dm.confidence_level = options.confidence_level;
-    DecoupledJointResult r = fit_decoupled_joint(runs, j, dm);
-    r.choices.insert(r.choices.begin(), choices.begin(), choices.end());
-    result = decoupled_model_to_json(model, r, used);
+  std::optional<IdentifiedResultFile> params;
+  ExperimentCompensation compensation;
+  if (o.model == "friction" && !o.params.empty()) {
+    params = read_identification_result(o.params);
+    require_same_robot(params->robot, model.name, "'" + o.params + "'",
+                       "give a result of this robot");
+    compensation = {&*params, o.params};
   }
-  result["locked_joints"] = locked_joints_to_json(model);
+  std::vector<std::string> warnings;
+  const nlohmann::json result =
+      identify_joint_experiment(model, runs, joint_experiment_of(o.model), o.joint - 1, options,
+                                used, compensation, warnings);
+  for (const std::string& w : warnings) warn("identify: " + w);
   std::vector<std::pair<std::string, std::string>> echoed;
   for (auto& [k, v] : result["choices"].items()) echoed.emplace_back(k, v.get<std::string>());
   echo_choices("identify", read, echoed);
@@ -484,9 +443,13 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   const Model model = load_cli_robot(o.robot, o.robot_flags,
                                      {"identify", o.runs, file.columns, {}, "", file.topic});
   RunFileReport read;
-  IdentificationResult result;
-  RepeatedEstimate repeated;
+  IdentifiedRuns identified;
+  IdentificationResult& result = identified.result;
+  IdentifyRunsOptions run_options;
+  run_options.repeat = o.repeat;
+  run_options.physical = o.physical;
   std::vector<JointRecord> records;
+  std::optional<JointRecord> physical_run;
   if (o.stream) {
     // Reading the big file is the whole wait: the line counts its bytes.
     ProgressLine progress("identify", progress_wanted(o.quiet));
@@ -494,6 +457,8 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     result = identify_stream(model, o.data, file, options, {o.threads, true});
     progress.finish();
     options.progress = nullptr;  // it refers to this scope's line
+    // The physical fit's torque errors are measured on the run, read here only for it.
+    if (o.physical) physical_run = read_joint_record(o.runs.front(), model, file);
   } else {
     // Each run read on its own (same column mapping, window and torque scale for every run).
     // Reading a big file is most of the wait; the stages after it report as one step.
@@ -522,15 +487,7 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
       for (size_t i = 0; i < o.runs.size(); ++i)
         references.push_back(read_reference_columns(o.runs[i], model, file, records[i]));
     }
-    // Every check the repeat can fail runs before the whole-run estimate (minutes on a long run).
-    RepeatedPieces pieces;
-    if (!o.repeat.empty()) {
-      pieces = repeated_pieces(records, references, options,
-                               o.repeat == "runs" ? RepeatOver::kRuns : RepeatOver::kPeriods);
-    }
-    result =
-        identify(model, records, closed ? references : std::vector<ReferenceRecord>{}, options);
-    if (!o.repeat.empty()) repeated = identify_repeated(model, pieces, options);
+    identified = identify_runs(model, records, references, options, run_options);
     progress.finish();
     options.progress = nullptr;  // it refers to this scope's line
     for (size_t i = 0; i < result.runs.size(); ++i) result.runs[i].file = o.runs[i];
@@ -538,58 +495,21 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   }
   echo_choices("identify", read, result.choices);
   std::cout << identification_table(model, result);
-  // Record the Coulomb columns identify actually used (the automatic zero-velocity rule turns the
-  // filtered expected-sign columns on), so that validate rebuilds the same regressor.
   nlohmann::json used = echo(o);
-  used["filter_coulomb_columns"] = result.processed.moving_positive.size() != 0;
   if (o.runs.size() > 1) used["data_runs"] = o.runs;
   if (!o.history.empty()) used["history"] = o.history;
-  if (!options.known_friction.empty()) {
-    std::vector<std::string> known_names;
-    Eigen::VectorXd known_values;
-    known_friction_parameters(options.known_friction, known_names, known_values);
-    used["known_friction"] = nlohmann::json::array();
-    for (size_t i = 0; i < known_names.size(); ++i)
-      used["known_friction"].push_back(
-          {{"name", known_names[i]}, {"value", known_values[static_cast<Eigen::Index>(i)]}});
-  }
-  nlohmann::json out = identification_to_json(model, result, used);
-  if (closed) out["closed_loop"] = closed_loop_to_json(result.closed_loop);
-  if (!o.repeat.empty()) {
-    out["repeated"] = repeated_to_json(repeated, o.repeat);
-    std::cout << "repeated over " << repeated.n << " " << o.repeat
+  identified_runs_to_json(model, records, options, run_options, used, identified,
+                          physical_run ? &*physical_run : nullptr);
+  const nlohmann::json& out = identified.json;
+  if (identified.repeated) {
+    std::cout << "repeated over " << identified.repeated->n << " " << o.repeat
               << ": mean, std and t/sqrt(n-1)*std per parameter in " << o.out << '\n';
   }
-  // What a report plots: the first run's measured and predicted torques as processed (the
-  // streaming mode keeps no run), and the RLS history.
-  std::optional<ValidationResult> first_run_fit;
-  if (!records.empty()) {
-    IdentifyOptions same = options;
-    same.signal.cutoff_hz = result.processed.cutoff_hz;
-    std::vector<std::string> names = result.names;
-    Eigen::VectorXd values = result.estimate.x;
-    append_known_friction(options.known_friction, names, values, same.layout);
-    try {
-      first_run_fit =
-          validate_torques(model, records.front(), names, values, same, result.not_excited);
-      out["plot"] = prediction_plot_json(*first_run_fit, joint_names(model));
-    } catch (const Error& e) {  // the result stands without its plot
-      warn(std::string("no torque plot in the result: ") + e.what());
-    }
-    if (result.history_x.rows() > 0) out["plot"]["history"] = rls_history_plot_json(result);
-    if (o.model == "integral") out["plot"]["energy"] = energy_plot_json(model, result, options);
-  }
-  if (o.physical) {
-    // The torque errors on the first run (read here only in the streaming mode, which keeps no
-    // run in memory).
-    if (records.empty()) records.push_back(read_joint_record(o.runs.front(), model, file));
-    const PhysicalCheck c = physical_parameters_of_result(
-        model, result, options, records.front(), "--physical",
-        first_run_fit ? std::optional<double>(first_run_fit->relative_error_all) : std::nullopt);
-    physical_parameters_to_json(c.fit, c.physical_error, c.free_error, out, c.warnings);
+  if (identified.physical) {
+    const PhysicalCheck& c = *identified.physical;
     std::cout << physical_parameters_text(c.fit, c.physical_error, c.free_error);
-    for (const std::string& w : c.warnings) warn("--physical: " + w);
   }
+  for (const std::string& w : identified.warnings) warn(w);
   write_json(o.out, out);
   std::cout << "wrote " << o.out << '\n';
   if (!o.history.empty()) {

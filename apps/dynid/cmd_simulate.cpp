@@ -13,6 +13,7 @@
 #include "dynid/sim/load_sensor.hpp"
 #include "dynid/sim/pid_gains.hpp"
 #include "dynid/sim/simulate_reference.hpp"
+#include "dynid/workflow/simulate_run.hpp"
 #include "flag_checks.hpp"
 #include "robot_flags.hpp"
 
@@ -43,9 +44,6 @@ std::optional<MountedLoad> payload_options(const SimulateCliOptions& o, const Mo
   }
   if (o.payload_link.empty()) {
     throw UsageError("--payload needs --payload-link LINK: the link that carries the sensor");
-  }
-  if (o.wrench_noise.size() > 2) {
-    throw UsageError("--wrench-noise takes one std for all six components or two: FORCE,MOMENT");
   }
   MountedLoad load;
   load.mount.link = find_link(model, o.payload_link);
@@ -81,7 +79,11 @@ void run(const SimulateCliOptions& o) {
                      {"simulate", {o.trajectory}, {}, selection_stored_in(o.params), o.params});
   const std::optional<MountedLoad> load = payload_options(o, model);
   const JointRecord ref = read_reference(o.trajectory, model);
-  SimulateOptions s;
+  SimulateRunOptions options;
+  options.load = load;
+  options.wrench_noise = o.wrench_noise;
+  options.truth = o.truth;
+  SimulateOptions& s = options.simulate;
   s.feed_forward = o.controller == "pid"               ? FeedForward::kNone
                    : o.controller == "computed-torque" ? FeedForward::kInverseDynamics
                                                        : FeedForward::kComputedTorque;
@@ -95,36 +97,14 @@ void run(const SimulateCliOptions& o) {
   s.sensors.position_delay = s.sensors.torque_delay = o.delay;
   s.sensors.seed = o.seed;
   s.loop.periods = o.periods;
-  s.loop.record_truth = o.truth || load.has_value();  // the wrench follows the true motion
-  PidOptions pid;
   ProgressLine progress("simulate", progress_wanted(o.quiet));
   s.loop.progress = progress.callback();
-  const ClosedLoopResult r = simulate_reference(load ? model_with_load(model, *load) : model, ref.t,
-                                                ref.q, ref.dq, ref.ddq, s, &pid);
+  const SimulatedRun r = simulate_run(model, ref.t, ref.q, ref.dq, ref.ddq, options);
   progress.finish();
-  const Eigen::Index n = model.dof();
-  std::vector<std::string> cols = {"t"};
-  std::vector<const char*> prefixes = {"qr", "q", "tau"};
-  if (o.truth) prefixes.insert(prefixes.end(), {"dq", "ddq"});
-  for (const char* p : prefixes)
-    for (Eigen::Index j = 0; j < n; ++j) cols.push_back(p + std::to_string(j + 1));
-  if (load) cols.insert(cols.end(), {"fx", "fy", "fz", "mx", "my", "mz"});
-  Eigen::MatrixXd data(r.t.size(), static_cast<Eigen::Index>(cols.size()));
-  if (o.truth) {
-    data.leftCols(1 + 5 * n) << r.t, r.qr, r.q, r.tau, r.dq_true, r.ddq_true;
-  } else {
-    data.leftCols(1 + 3 * n) << r.t, r.qr, r.q, r.tau;
-  }
-  if (load) {
-    Eigen::MatrixXd wrench = load_sensor_wrench(model, *load, r.q_true, r.dq_true, r.ddq_true);
-    add_wrench_noise(wrench, o.wrench_noise.empty() ? 0.0 : o.wrench_noise[0],
-                     o.wrench_noise.empty() ? 0.0 : o.wrench_noise.back(), o.seed + 1);
-    data.rightCols(6) = wrench;
-  }
   const std::string gains_path = gains_file_for_run(o.out);
-  write_csv(o.out, cols, data);
-  write_pid_gains(gains_path, model, pid, o.delay);
-  std::cout << "simulated " << r.t.size() << " samples (" << o.periods << " periods) on the "
+  write_csv(o.out, r.columns, r.data);
+  write_pid_gains(gains_path, model, r.pid, o.delay);
+  std::cout << "simulated " << r.data.rows() << " samples (" << o.periods << " periods) on the "
             << o.engine << " plant with " << o.controller << "; wrote " << o.out << " and "
             << gains_path << '\n';
 }

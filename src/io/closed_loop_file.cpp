@@ -43,6 +43,40 @@ ReferenceRecord read_reference_columns(const std::string& path, const Model& mod
   return out;
 }
 
+SensorNoise sensor_noise_from_json(const nlohmann::json& j, const Model& model, bool averaged,
+                                   const std::string& name) {
+  if (!j.is_object() || !j.contains("channels") || !j["channels"].is_array())
+    throw Error(name + " has no channels list; give the file of dynid average --json");
+  const std::string field = averaged ? "std_averaged" : "std";
+  const int n = model.dof();
+  SensorNoise out;
+  out.q.resize(n);
+  out.tau.resize(n);
+  auto find = [&](const std::string& prefix, int joint) {
+    const std::string a = prefix + std::to_string(joint + 1);
+    const std::string b = prefix + "_" + model.joints[static_cast<size_t>(joint)].name;
+    for (const auto& c : j["channels"]) {
+      if (!c.is_object() || !c.contains("name") || !c["name"].is_string()) continue;
+      const std::string channel = c["name"].get<std::string>();
+      if (channel != a && channel != b) continue;
+      if (!c.contains(field) || !c[field].is_number() || !std::isfinite(c[field].get<double>()) ||
+          c[field].get<double>() < 0.0)
+        throw Error(
+            name + ": channel " + channel + " has no finite " + field +
+            " >= 0; give the file of dynid average --json" +
+            (averaged ? " (a file written before std_averaged existed: average again)" : ""));
+      return c[field].get<double>();
+    }
+    throw Error(name + " has no channel " + a +
+                ": average the run with its q and tau columns (dynid average)");
+  };
+  for (int k = 0; k < n; ++k) {
+    out.q[k] = find("q", k);
+    out.tau[k] = find("tau", k);
+  }
+  return out;
+}
+
 SensorNoise read_sensor_noise(const std::string& path, const Model& model, const std::string& data,
                               std::string* which) {
   require_regular_file(path, "--noise");
@@ -54,19 +88,16 @@ SensorNoise read_sensor_noise(const std::string& path, const Model& model, const
   } catch (const nlohmann::json::exception&) {
     throw Error("--noise '" + path + "' is not JSON; give the file of dynid average --json");
   }
-  if (!j.contains("channels") || !j["channels"].is_array())
-    throw Error("--noise '" + path +
-                "' has no channels list; give the file of dynid average "
-                "--json");
+  const std::string name = "--noise '" + path + "'";
+  if (!j.is_object()) return sensor_noise_from_json(j, model, false, name);
   // The mean period's noise is the raw one over √(periods·decimate): fitting the mean with the
   // raw std misstates the variance factor by that ratio (docs/methods/closed_loop.md).
-  auto same_file = [](const nlohmann::json& name, const std::string& other) {
+  auto same_file = [](const nlohmann::json& file, const std::string& other) {
     std::error_code ec;
-    return !other.empty() && name.is_string() &&
-           std::filesystem::equivalent(name.get<std::string>(), other, ec) && !ec;
+    return !other.empty() && file.is_string() &&
+           std::filesystem::equivalent(file.get<std::string>(), other, ec) && !ec;
   };
   const bool averaged = same_file(j.value("out", nlohmann::json()), data);
-  const std::string field = averaged ? "std_averaged" : "std";
   if (which) {
     if (averaged)
       *which = path + ": std_averaged, the noise of the mean period " + data + " (" +
@@ -78,33 +109,7 @@ SensorNoise read_sensor_noise(const std::string& path, const Model& model, const
     else
       *which = path + ": std, the raw per-sample noise of the run " + data;
   }
-  const int n = model.dof();
-  SensorNoise out;
-  out.q.resize(n);
-  out.tau.resize(n);
-  auto find = [&](const std::string& prefix, int joint) {
-    const std::string a = prefix + std::to_string(joint + 1);
-    const std::string b = prefix + "_" + model.joints[static_cast<size_t>(joint)].name;
-    for (const auto& c : j["channels"]) {
-      if (!c.is_object() || !c.contains("name") || !c["name"].is_string()) continue;
-      const std::string name = c["name"].get<std::string>();
-      if (name != a && name != b) continue;
-      if (!c.contains(field) || !c[field].is_number() || !std::isfinite(c[field].get<double>()) ||
-          c[field].get<double>() < 0.0)
-        throw Error(
-            "--noise '" + path + "': channel " + name + " has no finite " + field +
-            " >= 0; give the file of dynid average --json" +
-            (averaged ? " (a file written before std_averaged existed: average again)" : ""));
-      return c[field].get<double>();
-    }
-    throw Error("--noise '" + path + "' has no channel " + a +
-                ": average the run with its q and tau columns (dynid average)");
-  };
-  for (int k = 0; k < n; ++k) {
-    out.q[k] = find("q", k);
-    out.tau[k] = find("tau", k);
-  }
-  return out;
+  return sensor_noise_from_json(j, model, averaged, name);
 }
 
 SensorNoise parse_noise_std(const std::string& text, int joints) {

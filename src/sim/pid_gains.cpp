@@ -94,8 +94,7 @@ std::string gains_file_for_run(const std::string& run_path) {
   return (csv ? run_path.substr(0, run_path.size() - suffix.size()) : run_path) + ".gains.json";
 }
 
-void write_pid_gains(const std::string& path, const Model& model, const PidOptions& pid,
-                     int delay_samples) {
+nlohmann::json pid_gains_to_json(const Model& model, const PidOptions& pid, int delay_samples) {
   auto list = [](const Eigen::VectorXd& v) {
     return std::vector<double>(v.data(), v.data() + v.size());
   };
@@ -113,7 +112,12 @@ void write_pid_gains(const std::string& path, const Model& model, const PidOptio
   out["derivative_filter_time"] = pid.derivative_filter_time;
   out["effort_limit"] = list(pid.effort_limit);
   out["delay_samples"] = delay_samples;
-  write_json(path, out);
+  return out;
+}
+
+void write_pid_gains(const std::string& path, const Model& model, const PidOptions& pid,
+                     int delay_samples) {
+  write_json(path, pid_gains_to_json(model, pid, delay_samples));
 }
 
 }  // namespace dynid

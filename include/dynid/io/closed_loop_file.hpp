@@ -27,6 +27,14 @@ ReferenceRecord read_reference_columns(const std::string& path, const Model& mod
 SensorNoise read_sensor_noise(const std::string& path, const Model& model,
                               const std::string& data = "", std::string* which = nullptr);
 
+/// Sensor noise per joint from the parsed JSON of `dynid average --json` (or the dict of the
+/// Python average()): channels q<j>, tau<j> or q_<joint>, tau_<joint>, their std_averaged (the
+/// mean period's noise) when `averaged`, else std (the raw per-sample noise). `name` names the
+/// input in messages. Throws dynid::Error for no channels list, a missing channel or field, or a
+/// std that is not a finite number >= 0.
+SensorNoise sensor_noise_from_json(const nlohmann::json& j, const Model& model, bool averaged,
+                                   const std::string& name);
+
 /// `--noise-std q=S,tau=S` (one value for every joint each; either may be omitted). Throws
 /// dynid::UsageError for anything else or a value that is not finite and >= 0.
 SensorNoise parse_noise_std(const std::string& text, int joints);

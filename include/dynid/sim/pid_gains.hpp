@@ -2,6 +2,8 @@
 
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "dynid/model/model.hpp"
 #include "dynid/sim/pid_controller.hpp"
 #include "dynid/sim/simulate_reference.hpp"
@@ -21,10 +23,13 @@ PidGains read_pid_gains(const std::string& path, const Model& model);
 /// .gains.json appended); validate --mode simulation looks for it there.
 std::string gains_file_for_run(const std::string& run_path);
 
-/// Writes the controller `pid` runs with as JSON to `path` (atomically): controller ("pid",
-/// "pid-feedforward" or "computed-torque"), joints (names), kp, ki, kd, sample_time [s],
-/// derivative_filter_time [s], effort_limit, delay_samples (the position delay the default rule was
-/// made for). Throws dynid::Error when the file cannot be written.
+/// The controller `pid` runs with as JSON: controller ("pid", "pid-feedforward" or
+/// "computed-torque"), joints (names), kp, ki, kd, sample_time [s], derivative_filter_time [s],
+/// effort_limit, delay_samples (the position delay the default rule was made for).
+nlohmann::json pid_gains_to_json(const Model& model, const PidOptions& pid, int delay_samples);
+
+/// Writes pid_gains_to_json() to `path` (atomically). Throws dynid::Error when the file cannot be
+/// written.
 void write_pid_gains(const std::string& path, const Model& model, const PidOptions& pid,
                      int delay_samples);
 
