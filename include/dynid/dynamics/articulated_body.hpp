@@ -8,7 +8,7 @@
 namespace dynid {
 
 /// Forward dynamics by the articulated-body algorithm (Featherstone 2008, Table 7.1; O(n)):
-/// the ddq with rnea(q, dq, ddq, options) = tau, i.e. ddq = M⁻¹(tau − rnea(q, dq, 0, options)).
+/// ddq = M⁻¹(tau − rnea(q, dq, 0, options)), so rnea(q, dq, ddq) = tau with the default options.
 /// Semantics as crba_forward_dynamics: the actuator inertia Ia always adds to the joint's inertia
 /// (as in mass_matrix); options.joint_terms switches the friction torques Fv·dq + Fc·sign(dq) + Fo
 /// (+ asymmetry), options.gravity the model's gravity. q, dq, tau, ddq: size n (rad, m; N·m, N).
