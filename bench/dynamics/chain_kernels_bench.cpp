@@ -21,14 +21,25 @@ namespace {
 
 using dynid::Model;
 
-// A random chain of n revolute joints (tests/support/random_models.hpp), or a built-in robot for
-// n = 0 (puma560) and n = 1 (iiwa14).
+// A tree of `branches` random chains of `length` revolute joints on one root joint.
+Model branching(int branches, int length) {
+  Model m = dynid::testing::random_tree(1 + branches * length, 30, false, true);
+  for (int j = 1; j < m.dof(); ++j) m.joints[j].parent = (j - 1) % length == 0 ? 0 : j - 1;
+  m.finalize();
+  return m;
+}
+
+// A random chain of n revolute joints (tests/support/random_models.hpp), or for n < 6: a built-in
+// robot (0: puma560, 1: iiwa14) or a tree of 31 joints (2: five branches of 6 on a root, mean
+// depth 4.4; 3: two branches of 15, mean depth 8.7).
 const Model& model_for(int n) {
   static std::map<int, Model> cache;
   auto it = cache.find(n);
   if (it == cache.end()) {
     Model m = n == 0   ? dynid::load_robot("puma560")
               : n == 1 ? dynid::load_robot("iiwa14")
+              : n == 2 ? branching(5, 6)
+              : n == 3 ? branching(2, 15)
                        : dynid::testing::random_tree(n, 30, false, true);
     it = cache.emplace(n, std::move(m)).first;
   }
@@ -117,9 +128,9 @@ void sizes(benchmark::internal::Benchmark* b) {
   for (int n : {0, 1, 6, 7, 12, 18, 24, 30}) b->Arg(n);  // 0: puma560, 1: iiwa14
 }
 
-// The forward dynamics also around the crossover.
+// The forward dynamics also around the crossover and on two trees.
 void fd_sizes(benchmark::internal::Benchmark* b) {
-  for (int n : {0, 1, 6, 7, 10, 12, 14, 16, 18, 24, 30}) b->Arg(n);
+  for (int n : {0, 1, 2, 3, 6, 7, 10, 12, 14, 16, 18, 24, 30}) b->Arg(n);
 }
 
 }  // namespace
