@@ -2,6 +2,7 @@
 
 #include <cassert>
 
+#include "dynamics/body_inertia.hpp"
 #include "dynamics/joint_pose.hpp"
 #include "dynid/dynamics/kinematics.hpp"
 #include "dynid/dynamics/rnea.hpp"
@@ -9,32 +10,6 @@
 namespace dynid {
 
 namespace {
-
-// I_P += R·I·Rᵀ + 2(p·u)·1 − (u·pᵀ + p·uᵀ), h_P += R·h + m·p, m_P += m with u = R·h + m·p/2:
-// a subtree's inertia about origin j moved to the parent's origin and axes. R·I·Rᵀ is taken as
-// I_zz·1 + Σ (v_k·r_kᵀ + r_k·v_kᵀ) over the columns r_0, r_1 of R (docs/methods/dynamics.md,
-// "Mass matrix"): 53 products for the six distinct entries of I_P instead of 57, and shorter
-// dependency chains than R·I followed by (R·I)·Rᵀ.
-inline void add_to_parent(const Eigen::Matrix3d& R, const Eigen::Vector3d& p, const BodyInertia& c,
-                          BodyInertia& cp) {
-  const Eigen::Vector3d hR = R * c.h;
-  const Eigen::Vector3d u = hR + 0.5 * c.m * p;
-  const double izz = c.I(2, 2);
-  const Eigen::Vector3d v0 =
-      (0.5 * (c.I(0, 0) - izz)) * R.col(0) + c.I(0, 1) * R.col(1) + c.I(0, 2) * R.col(2);
-  const Eigen::Vector3d v1 = (0.5 * (c.I(1, 1) - izz)) * R.col(1) + c.I(1, 2) * R.col(2);
-  const double d = izz + 2.0 * p.dot(u);
-  for (int r = 0; r < 3; ++r) {
-    for (int k = r; k < 3; ++k) {
-      const double v = v0[r] * R(k, 0) + R(r, 0) * v0[k] + v1[r] * R(k, 1) + R(r, 1) * v1[k] -
-                       (u[r] * p[k] + p[r] * u[k]);
-      cp.I(r, k) += r == k ? v + d : v;
-      if (r != k) cp.I(k, r) = cp.I(r, k);
-    }
-  }
-  cp.h += hR + c.m * p;
-  cp.m += c.m;
-}
 
 // The six force components (moment about origin j; force) of the columns, one array each.
 struct ColumnForces {
@@ -187,7 +162,7 @@ void composite_rigid_body(const Model& model, Workspace& ws, Eigen::Ref<Eigen::M
         if (in_subtree(model, k, j)) forces_to_parent(R, pj, F, k, k + 1);
       }
     }
-    add_to_parent(R, pj, c, ws.composite[parent]);
+    detail::add_to_parent(R, pj, c, ws.composite[parent]);
   }
 }
 
@@ -205,10 +180,11 @@ void mass_matrix(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen
   composite_rigid_body(model, ws, M);
 }
 
-void forward_dynamics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
-                      const Eigen::Ref<const Eigen::VectorXd>& dq,
-                      const Eigen::Ref<const Eigen::VectorXd>& tau, Eigen::Ref<Eigen::VectorXd> ddq,
-                      const RneaOptions& options) {
+void crba_forward_dynamics(const Model& model, Workspace& ws,
+                           const Eigen::Ref<const Eigen::VectorXd>& q,
+                           const Eigen::Ref<const Eigen::VectorXd>& dq,
+                           const Eigen::Ref<const Eigen::VectorXd>& tau,
+                           Eigen::Ref<Eigen::VectorXd> ddq, const RneaOptions& options) {
   const int n = model.dof();
   ws.scratch_n2.setZero();
   // Bias c + g + friction at ddq = 0; it leaves the poses of q in ws.links for the CRBA.
@@ -238,6 +214,22 @@ void forward_dynamics(const Model& model, Workspace& ws, const Eigen::Ref<const 
     for (int j = model.joints[i].parent; j >= 0; j = model.joints[j].parent) {
       ddq[i] -= H(i, j) * ddq[j];
     }
+  }
+}
+
+bool prefers_articulated_body(const Workspace& ws) {
+  const auto n = static_cast<long>(ws.links.size());
+  return 2L * ws.depth_sum >= (kArticulatedBodyMinChain + 1L) * n;
+}
+
+void forward_dynamics(const Model& model, Workspace& ws, const Eigen::Ref<const Eigen::VectorXd>& q,
+                      const Eigen::Ref<const Eigen::VectorXd>& dq,
+                      const Eigen::Ref<const Eigen::VectorXd>& tau, Eigen::Ref<Eigen::VectorXd> ddq,
+                      const RneaOptions& options) {
+  if (prefers_articulated_body(ws)) {
+    articulated_body_forward_dynamics(model, ws, q, dq, tau, ddq, options);
+  } else {
+    crba_forward_dynamics(model, ws, q, dq, tau, ddq, options);
   }
 }
 

@@ -13,10 +13,13 @@ Workspace::Workspace(const Model& model)
       forces(model.dof(), 6),
       scratch_nn(model.dof(), model.dof()),
       scratch_n(model.dof()),
-      scratch_n2(model.dof()) {
+      scratch_n2(model.dof()),
+      articulated(model.dof()),
+      derivative(model.dof()) {
   for (int j = 0; j < model.dof(); ++j) {
     for (int i = j; i >= 0; i = model.joints[i].parent) ancestors[j].push_back(i);
     twists[j].resize(ancestors[j].size());
+    depth_sum += static_cast<int>(ancestors[j].size());
   }
   std::vector<int> size(model.dof(), 1);
   for (int j = model.dof() - 1; j >= 0; --j) {

@@ -22,11 +22,9 @@ class NativePlant final : public Plant {
         n_(model.dof()),
         q_(Eigen::VectorXd::Zero(n_)),
         dq_(Eigen::VectorXd::Zero(n_)),
-        zero_(Eigen::VectorXd::Zero(n_)),
-        bias_(n_),
+        net_torque_(n_),
         friction_(n_),
-        M_(n_, n_),
-        llt_(n_) {
+        M_(n_, n_) {
     check_plant_friction(model_, options_.friction);
     if (!(options_.max_step > 0.0) || !std::isfinite(options_.max_step))
       throw Error("native plant max_step must be a finite value > 0 [s], e.g. 0.001");
@@ -93,17 +91,16 @@ class NativePlant final : public Plant {
   }
 
  private:
-  // ddq = M(q)⁻¹(tau − c(q, dq) − g(q) − F(dq)); M includes the armature Ia.
+  // ddq = M(q)⁻¹(tau − c(q, dq) − g(q) − F(dq)); M includes the armature Ia. The plant's own
+  // (smoothed) friction F replaces the model's joint terms; forward_dynamics picks CRBA + LᵀDL or
+  // the articulated-body algorithm by the model's shape.
   void rhs(const Eigen::VectorXd& q, const Eigen::VectorXd& dq,
            const Eigen::Ref<const Eigen::VectorXd>& tau, Eigen::Ref<Eigen::VectorXd> ddq) {
-    RneaOptions bias_options;
-    bias_options.joint_terms = false;
-    rnea(model_, ws_, q, dq, zero_, bias_, bias_options);
+    RneaOptions options;
+    options.joint_terms = false;
     plant_friction_torque(model_, options_.friction, dq, friction_);
-    mass_matrix(model_, ws_, q, M_);
-    llt_.compute(M_);
-    ddq = tau - bias_ - friction_;
-    llt_.solveInPlace(ddq);
+    net_torque_ = tau - friction_;
+    forward_dynamics(model_, ws_, q, dq, net_torque_, ddq, options);
   }
 
   // Enough sub-steps for h ≤ max_step and for explicit stability on the stiffest friction slope:
@@ -128,10 +125,9 @@ class NativePlant final : public Plant {
   Workspace ws_;
   double dt_;
   int n_;
-  Eigen::VectorXd q_, dq_, zero_, bias_, friction_, q_stage_, dq_stage_;
+  Eigen::VectorXd q_, dq_, net_torque_, friction_, q_stage_, dq_stage_;
   Eigen::VectorXd kq_[4], kdq_[4];
   Eigen::MatrixXd M_;
-  Eigen::LLT<Eigen::MatrixXd> llt_;
   double time_ = 0.0;
   long steps_ = 0;
   int substeps_ = 1;

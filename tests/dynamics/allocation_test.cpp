@@ -1,6 +1,6 @@
 // The hot paths do not allocate: every heap allocation in this test binary is counted, and the
-// count must not change across calls of rnea, mass_matrix, forward_dynamics and the regressors
-// with a reused Workspace.
+// count must not change across calls of rnea, its derivatives, mass_matrix, the forward dynamics
+// (both algorithms) and the regressors with a reused Workspace.
 #include <atomic>
 #include <cstdlib>
 #include <new>
@@ -9,6 +9,7 @@
 
 #include "dynid/dynamics/mass_matrix.hpp"
 #include "dynid/dynamics/rnea.hpp"
+#include "dynid/dynamics/rnea_derivatives.hpp"
 #include "dynid/model/robots.hpp"
 #include "dynid/regressor/energy_regressor.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
@@ -48,12 +49,15 @@ TEST(Allocation, HotPathsDoNotAllocate) {
     const ParameterLayout layout = ParameterLayout::full();
     Eigen::VectorXd q = Eigen::VectorXd::Constant(n, 0.3), dq = Eigen::VectorXd::Constant(n, 0.5),
                     ddq = Eigen::VectorXd::Constant(n, -0.2), tau(n), h(layout.columns(n));
-    Eigen::MatrixXd M(n, n), Y(n, layout.columns(n));
+    Eigen::MatrixXd M(n, n), Y(n, layout.columns(n)), d_q(n, n), d_dq(n, n);
     const long before = g_allocations.load();
     for (int k = 0; k < 10; ++k) {
       rnea(model, ws, q, dq, ddq, tau);
       mass_matrix(model, ws, q, M);
       forward_dynamics(model, ws, q, dq, tau, ddq);
+      crba_forward_dynamics(model, ws, q, dq, tau, ddq);
+      articulated_body_forward_dynamics(model, ws, q, dq, tau, ddq);
+      rnea_derivatives(model, ws, q, dq, ddq, d_q, d_dq, M);
       torque_regressor(model, ws, layout, q, dq, ddq, Y);
       energy_regressor(model, ws, layout, q, dq, h);
     }

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
 
+#include "dynid/dynamics/articulated_body.hpp"
 #include "dynid/dynamics/energy.hpp"
 #include "dynid/dynamics/kinematics.hpp"
 #include "dynid/dynamics/mass_matrix.hpp"
@@ -19,7 +20,9 @@ using testing::random_tree;
 using testing::random_vector;
 using testing::rel_diff;
 
-TEST(Rnea, Planar2MatchesClosedForm) {
+// The closed form is the oracle of both directions: RNEA gives its torque, the articulated-body
+// algorithm its acceleration back.
+TEST(Planar2, RneaAndArticulatedBodyMatchClosedForm) {
   const testing::Planar2 arm;
   const Model model = arm.model();
   Workspace ws(model);
@@ -27,9 +30,11 @@ TEST(Rnea, Planar2MatchesClosedForm) {
   for (int k = 0; k < 50; ++k) {
     const Eigen::VectorXd q = random_vector(2, rng, 3.0), dq = random_vector(2, rng, 2.0),
                           ddq = random_vector(2, rng, 5.0);
-    Eigen::VectorXd tau(2);
+    Eigen::VectorXd tau(2), ddq_aba(2);
     rnea(model, ws, q, dq, ddq, tau);
     EXPECT_LT(rel_diff(tau, arm.torque(q, dq, ddq)), 1e-12) << "state " << k;
+    articulated_body_forward_dynamics(model, ws, q, dq, arm.torque(q, dq, ddq), ddq_aba);
+    EXPECT_LT(rel_diff(ddq_aba, ddq), 1e-12) << "state " << k;
   }
 }
 

@@ -1,4 +1,5 @@
-// RNEA (with armature and viscous friction) against MuJoCo's mj_inverse on the same URDF text.
+// RNEA (with armature and viscous friction), the mass matrix and the articulated-body forward
+// dynamics against MuJoCo's mj_inverse and qM on the same URDF text.
 #include <cstdio>
 #include <fstream>
 #include <random>
@@ -6,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
+#include "dynid/dynamics/articulated_body.hpp"
 #include "dynid/dynamics/mass_matrix.hpp"
 #include "dynid/dynamics/rnea.hpp"
 #include "dynid/io/urdf_writer.hpp"
@@ -117,6 +119,12 @@ TEST_P(MujocoOracle, RneaMatchesMjInverse) {
     rnea(compiled, ws, q, dq, ddq, tau);
     for (int j = 0; j < 8; ++j) tau_mj[j] = mj.d->qfrc_inverse[dof[j]];
     EXPECT_LT((tau - tau_mj).norm() / tau_mj.norm(), testing::kOracleTolerance) << "state " << k;
+    // The articulated-body algorithm takes MuJoCo's torque back to the acceleration it was given
+    // (the comparison carries cond(M), as the KDL forward dynamics check).
+    Eigen::VectorXd ddq_aba(8);
+    articulated_body_forward_dynamics(compiled, ws, q, dq, tau_mj, ddq_aba);
+    EXPECT_LT((ddq_aba - ddq).norm() / ddq.norm(), 1e3 * testing::kOracleTolerance)
+        << "state " << k;
     // Mass matrix (armature included) against MuJoCo's composite-rigid-body qM, made dense.
     std::vector<mjtNum> dense(8 * 8);
     mj_fullM(mj.m, dense.data(), mj.d->qM);
