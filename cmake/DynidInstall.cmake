@@ -3,7 +3,8 @@
 #                                      public headers, the built-in robots (share/dynid/robots),
 #                                      the CMake package dynid (dynid::dynid) and dynid.pc;
 #   cpack -G DEB (in build/)           the same as a Debian package.
-# In a parent project (add_subdirectory(dynid)), dynid::dynid is the build tree's static library.
+# In a parent project (add_subdirectory(dynid)), dynid::dynid is the build tree's static library,
+# and nothing of dynid is installed or packaged unless the parent sets DYNID_INSTALL.
 include_guard(GLOBAL)
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
@@ -11,6 +12,12 @@ include(CMakePackageConfigHelpers)
 add_library(dynid::dynid ALIAS dynid_lib)
 # dladdr (src/model/robots.cpp): in libc since glibc 2.34, in libdl before.
 target_link_libraries(dynid_lib PRIVATE ${CMAKE_DL_LIBS})
+
+option(DYNID_INSTALL "Install rules, the shared library, CMake package, pkg-config and CPack"
+  ${PROJECT_IS_TOP_LEVEL})
+if(NOT DYNID_INSTALL)
+  return()
+endif()
 
 set(DYNID_ROBOTS_INSTALL_DIR ${CMAKE_INSTALL_DATADIR}/dynid/robots)
 set(DYNID_CMAKE_INSTALL_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/dynid)

@@ -75,11 +75,12 @@ prefix)
 subdirectory)
   cmake -S "$source_dir/examples/consumer" -B "$tmp/parent" -DDYNID_SOURCE="$source_dir" \
     >"$tmp/log" 2>&1 || fail "add_subdirectory(dynid) from a parent project: $(cat "$tmp/log")"
-  # A parent project gets the library and the CLI, not dynid's tests, benchmarks or module.
+  # A parent project gets the library and the CLI, not dynid's tests, benchmarks, Python module
+  # or installed shared library.
   cmake --build "$tmp/parent" --target help >"$tmp/targets"
   grep -q "dynid_lib" "$tmp/targets" || fail "no dynid_lib target in the parent project"
-  ! grep -Eq "model_tests|dynid_python" "$tmp/targets" ||
-    fail "the parent project builds dynid's tests or Python module"
+  ! grep -Eq "model_tests|dynid_python|dynid_shared" "$tmp/targets" ||
+    fail "the parent project builds dynid's tests, Python module or shared library"
   ;;
 deb)
   build_dir=$3
