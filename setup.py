@@ -44,9 +44,9 @@ def require_wheel():
             import wheel  # noqa: F401
         except ImportError:
             sys.exit(f"error: {sys.executable} lacks the Python package 'wheel' that pip needs to "
-                     "build dynid offline; use Debian's python: /usr/bin/python3 -m pip install "
-                     "--no-build-isolation . (python3-wheel, scripts/setup), or install wheel "
-                     "for this interpreter")
+                     "build dynid offline; use Debian's python3 (python3-wheel, scripts/setup), "
+                     "e.g. a venv made by /usr/bin/python3 -m venv --system-site-packages "
+                     "(README \"Install\"), or install wheel for this interpreter")
 
 
 class CMakeBuild(build_ext):
