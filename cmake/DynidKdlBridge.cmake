@@ -18,7 +18,7 @@ find_path(KDL_PARSER_INCLUDE_DIR kdl_parser/kdl_parser.hpp REQUIRED)
 add_library(dynid_kdl_bridge SHARED ${PROJECT_SOURCE_DIR}/tests/oracle/kdl_bridge.cpp)
 set_target_properties(dynid_kdl_bridge PROPERTIES
   CXX_VISIBILITY_PRESET hidden VISIBILITY_INLINES_HIDDEN ON
-  LIBRARY_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/lib)
+  LIBRARY_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/lib)
 get_target_property(dynid_kdl_bridge_options dynid_kdl_bridge COMPILE_OPTIONS)
 if(DYNID_NATIVE_OPTIONS)
   list(REMOVE_ITEM dynid_kdl_bridge_options ${DYNID_NATIVE_OPTIONS})

@@ -1,5 +1,7 @@
 #include "dynid/model/robots.hpp"
 
+#include <dlfcn.h>
+
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -25,11 +27,51 @@ std::string join(const std::vector<std::string>& v) {
   return s;
 }
 
+// The file this code was loaded from: libdynid.so, the Python extension dynid/_core*.so, or the
+// program it is linked into. For a program glibc reports argv[0], which may be a bare name found
+// on PATH: a path that does not resolve is no answer (the caller also asks /proc/self/exe).
+fs::path file_of_this_code() {
+  Dl_info info{};
+  // The address of a function of this file names the object that holds it (dladdr(3)).
+  if (dladdr(reinterpret_cast<void*>(&builtin_robots_dir), &info) == 0 ||
+      info.dli_fname == nullptr || *info.dli_fname == '\0') {
+    return {};
+  }
+  std::error_code ec;
+  const fs::path file = fs::canonical(info.dli_fname, ec);
+  return ec ? fs::path() : file;
+}
+
+// The robots installed with the code, relative to it so that a moved prefix keeps them:
+// `cmake --install` puts them in <prefix>/share/dynid/robots beside <prefix>/bin/dynid and
+// <prefix>/lib/libdynid.so; the Python package (setup.py) carries them as dynid/robots beside its
+// extension module. The code in a shared object looks beside that object only: the program that
+// loaded it (python3, a user's controller) is not dynid's, and its prefix may hold another dynid.
+// Empty when none is found (a build tree).
+fs::path installed_robots_dir() {
+  std::error_code ec;
+  const fs::path program = fs::canonical("/proc/self/exe", ec);
+  const fs::path code = file_of_this_code();
+  std::vector<fs::path> candidates;
+  if (!code.empty() && code != program) {
+    candidates = {code.parent_path() / ".." / "share" / "dynid" / "robots",
+                  code.parent_path() / "robots"};
+  } else if (!program.empty()) {
+    candidates = {program.parent_path() / ".." / "share" / "dynid" / "robots"};
+  }
+  for (const fs::path& candidate : candidates) {
+    if (fs::is_directory(candidate, ec)) return candidate.lexically_normal();
+  }
+  return {};
+}
+
 }  // namespace
 
 std::string builtin_robots_dir() {
   const char* env = std::getenv("DYNID_ROBOTS_DIR");
   if (env && *env) return env;
+  const fs::path installed = installed_robots_dir();
+  if (!installed.empty()) return installed.string();
   return std::string(DYNID_SOURCE_DIR) + "/examples/robots";
 }
 

@@ -8,8 +8,12 @@
 
 namespace dynid {
 
-/// Folder holding the built-in robots: $DYNID_ROBOTS_DIR if set and non-empty, else
-/// DYNID_SOURCE_DIR "/examples/robots" (compile definition of robots.cpp).
+/// Folder holding the built-in robots, the first of: $DYNID_ROBOTS_DIR if set and non-empty; the
+/// robots installed with the code, found relative to the file that holds it, so that a moved
+/// install prefix keeps them: for a shared library or Python extension <its dir>/../share/dynid/
+/// robots or <its dir>/robots, for a program <dir of /proc/self/exe>/../share/dynid/robots; else
+/// the source tree's DYNID_SOURCE_DIR "/examples/robots" (compile definition of robots.cpp).
+/// Never throws; the folder may not exist (builtin_robot_names() is then empty).
 std::string builtin_robots_dir();
 
 /// Short names of the built-in robots (file stems of the *.urdf, *.yaml, *.yml files in
