@@ -62,11 +62,12 @@ class FleetCli : public ::testing::Test {
   fs::path dir_;
 };
 
-const std::string kStream = " -r planar2 --stream --filter none --friction viscous --no-armature";
+const std::string kFleetStream =
+    " -r planar2 --stream --filter none --friction viscous --no-armature";
 
 // Estimates and σ equal up to the round-off of another summation order (1e-10 of the larger of
 // |value| and σ), and the same runs.
-void expect_same_result(const nlohmann::json& a, const nlohmann::json& b) {
+void expect_same_merged_result(const nlohmann::json& a, const nlohmann::json& b) {
   ASSERT_EQ(a["parameters"].size(), b["parameters"].size());
   for (std::size_t i = 0; i < a["parameters"].size(); ++i) {
     const auto& p = a["parameters"][i];
@@ -86,32 +87,32 @@ TEST_F(FleetCli, PartialsMergeToTheStreamOverAllRuns) {
   const std::string r1 = planar2_fleet_run("r1.csv", 0.8, 0.0, 1),
                     r2 = planar2_fleet_run("r2.csv", 0.8, 3.0, 2),
                     r3 = planar2_fleet_run("r3.csv", 0.8, 7.0, 3);
-  auto r = run("identify" + kStream + " -d " + r1 + " -d " + r2 + " -d " + r3 + " -o " +
+  auto r = run("identify" + kFleetStream + " -d " + r1 + " -d " + r2 + " -d " + r3 + " -o " +
                path("all.json"));
   ASSERT_EQ(r.code, 0) << r.err;
-  r = run("identify" + kStream + " -d " + r1 + " --partial " + path("p1.dpart"));
+  r = run("identify" + kFleetStream + " -d " + r1 + " --partial " + path("p1.dpart"));
   ASSERT_EQ(r.code, 0) << r.err;
-  r = run("identify" + kStream + " -d " + r2 + " -d " + r3 + " --partial " + path("p23.dpart") +
-          " -o " + path("r23.json"));
+  r = run("identify" + kFleetStream + " -d " + r2 + " -d " + r3 + " --partial " +
+          path("p23.dpart") + " -o " + path("r23.json"));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(fs::exists(path("r23.json")));
   r = run("merge " + path("p23.dpart") + " " + path("p1.dpart") + " -o " + path("m.json") +
           " --partial " + path("m.dpart") + " --report " + path("m.html"));
   ASSERT_EQ(r.code, 0) << r.err;
   const nlohmann::json all = load(path("all.json")), merged = load(path("m.json"));
-  expect_same_result(all, merged);
+  expect_same_merged_result(all, merged);
   EXPECT_EQ(merged["options"]["data_runs"], nlohmann::json::array({r2, r3, r1}));
   EXPECT_EQ(merged["options"]["robot"], "planar2");
   // The merged part is a part like any other: solved alone, the same result.
   r = run("merge " + path("m.dpart") + " -o " + path("m2.json"));
   ASSERT_EQ(r.code, 0) << r.err;
-  expect_same_result(all, load(path("m2.json")));
+  expect_same_merged_result(all, load(path("m2.json")));
 
   // --partial and --householder belong to --stream; --out or --partial is needed.
   r = run("identify -r planar2 --filter none -d " + r1 + " --partial " + path("x.dpart"));
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(testing::error_contract_problem(r.err), "");
-  r = run("identify" + kStream + " -d " + r1);
+  r = run("identify" + kFleetStream + " -d " + r1);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--out is required"), std::string::npos) << r.err;
   r = run("merge " + path("p1.dpart"));
@@ -120,7 +121,8 @@ TEST_F(FleetCli, PartialsMergeToTheStreamOverAllRuns) {
 
 TEST_F(FleetCli, PartsOfOtherOptionsOrDamagedAreRefusedWithNothingWritten) {
   const std::string r1 = planar2_fleet_run("r1.csv", 0.8, 0.0, 1);
-  ASSERT_EQ(run("identify" + kStream + " -d " + r1 + " --partial " + path("p1.dpart")).code, 0);
+  ASSERT_EQ(run("identify" + kFleetStream + " -d " + r1 + " --partial " + path("p1.dpart")).code,
+            0);
   auto r = run("identify -r planar2 --stream --filter none --friction none -d " + r1 +
                " --partial " + path("other.dpart"));
   ASSERT_EQ(r.code, 0) << r.err;
@@ -163,7 +165,7 @@ TEST_F(FleetCli, CompareFlagsTheChangedFrictionAndWritesItsPage) {
     const std::string run_file = planar2_fleet_run("night" + std::to_string(night) + ".csv",
                                                    fv[night], 2.0 * night, 10 + night);
     const std::string out = path("night" + std::to_string(night) + ".json");
-    const auto r = run("identify" + kStream + " -d " + run_file + " -o " + out);
+    const auto r = run("identify" + kFleetStream + " -d " + run_file + " -o " + out);
     ASSERT_EQ(r.code, 0) << r.err;
     results += " " + out;
   }

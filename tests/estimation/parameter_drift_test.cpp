@@ -14,7 +14,7 @@ namespace dynid {
 namespace {
 
 // Two-sided p-value of a standard normal z, the oracle.
-double two_sided(double z) {
+double drift_two_sided(double z) {
   const boost::math::normal n;
   return 2.0 * boost::math::cdf(boost::math::complement(n, std::abs(z)));
 }
@@ -43,20 +43,21 @@ TEST(ParameterDrift, HolmStepDownFlagsWhatBonferroniWouldMiss) {
   for (int i = 0; i < 4; ++i) {
     EXPECT_NEAR(c.rows[i].z, z[i], 1e-12);
     EXPECT_NEAR(c.rows[i].std_dev, 1.0, 1e-12);
-    EXPECT_NEAR(c.rows[i].p_value, two_sided(z[i]), 1e-12 * two_sided(z[i]) + 1e-300);
+    EXPECT_NEAR(c.rows[i].p_value, drift_two_sided(z[i]), 1e-12 * drift_two_sided(z[i]) + 1e-300);
   }
   // Holm: 4·p(5) and 3·p(3) = 0.0081 are ≤ 0.01; 2·p(2.5) = 0.025 is not, and the step-down
   // stops. Bonferroni (4·p(3) = 0.0108) would have missed Fv1.
-  EXPECT_NEAR(c.rows[1].p_adjusted, 3.0 * two_sided(3.0), 1e-12);
-  EXPECT_GT(4.0 * two_sided(3.0), 0.01);
+  EXPECT_NEAR(c.rows[1].p_adjusted, 3.0 * drift_two_sided(3.0), 1e-12);
+  EXPECT_GT(4.0 * drift_two_sided(3.0), 0.01);
   EXPECT_TRUE(c.rows[0].flagged);
   EXPECT_TRUE(c.rows[1].flagged);
   EXPECT_FALSE(c.rows[2].flagged);
   EXPECT_FALSE(c.rows[3].flagged);
-  EXPECT_NEAR(c.rows[2].p_adjusted, 2.0 * two_sided(2.5), 1e-12);
-  EXPECT_NEAR(c.rows[3].p_adjusted, std::max(2.0 * two_sided(2.5), two_sided(0.1)), 1e-12);
+  EXPECT_NEAR(c.rows[2].p_adjusted, 2.0 * drift_two_sided(2.5), 1e-12);
+  EXPECT_NEAR(c.rows[3].p_adjusted, std::max(2.0 * drift_two_sided(2.5), drift_two_sided(0.1)),
+              1e-12);
   // The first step's critical |z|: the (1 − α/(2m)) quantile.
-  EXPECT_NEAR(two_sided(c.first_critical_z), 0.01 / 4.0, 1e-12);
+  EXPECT_NEAR(drift_two_sided(c.first_critical_z), 0.01 / 4.0, 1e-12);
   EXPECT_EQ(c.rows[1].role, ParameterRole::kFriction);
 }
 

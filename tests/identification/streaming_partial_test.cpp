@@ -139,13 +139,13 @@ TEST(StreamPartial, PartsOfAnotherRobotOrOptionSetAreRefused) {
   refused(stream_partial(planar, {planar_run}, {}, o), "robot");
 }
 
-void write_bytes(const std::string& path, const std::string& bytes) {
+void write_partial_bytes(const std::string& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary)
       .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
 // Every error names the file and says what is wrong with it, in one line.
-void expect_refused(const std::string& path, const std::string& what) {
+void expect_partial_refused(const std::string& path, const std::string& what) {
   try {
     read_stream_partial(path);
     ADD_FAILURE() << "read: " << what;
@@ -173,29 +173,29 @@ TEST(StreamPartial, TruncatedOrCorruptFilesAreRefused) {
   for (std::size_t c = 32; c < good.size(); c += 37) cuts.push_back(c);
   cuts.push_back(good.size() - 1);
   for (const std::size_t c : cuts) {
-    write_bytes(bad, good.substr(0, c));
+    write_partial_bytes(bad, good.substr(0, c));
     const std::string expected = c < 8 ? "not a dynid partial result" : "";
-    expect_refused(bad, expected);
+    expect_partial_refused(bad, expected);
   }
   // A flipped byte anywhere after the magic: caught (mostly by the checksum).
   for (std::size_t at = 8; at < good.size(); at += good.size() / 23) {
     std::string flipped = good;
     flipped[at] = static_cast<char>(flipped[at] ^ 0x5a);
-    write_bytes(bad, flipped);
-    expect_refused(bad, "");
+    write_partial_bytes(bad, flipped);
+    expect_partial_refused(bad, "");
   }
   std::string version = good;
   version[8] = 2;
-  write_bytes(bad, version);
-  expect_refused(bad, "format version 2");
+  write_partial_bytes(bad, version);
+  expect_partial_refused(bad, "format version 2");
   std::string swapped = good;
   std::reverse(swapped.begin() + 12, swapped.begin() + 16);
-  write_bytes(bad, swapped);
-  expect_refused(bad, "other byte order");
-  write_bytes(bad, "t,q1\n0,1\n");
-  expect_refused(bad, "not a dynid partial result");
+  write_partial_bytes(bad, swapped);
+  expect_partial_refused(bad, "other byte order");
+  write_partial_bytes(bad, "t,q1\n0,1\n");
+  expect_partial_refused(bad, "not a dynid partial result");
   // A good file still reads.
-  write_bytes(bad, good);
+  write_partial_bytes(bad, good);
   EXPECT_EQ(read_stream_partial(bad).runs.size(), 1u);
 }
 
