@@ -19,8 +19,10 @@
 #include "dynid/common/error.hpp"
 #include "dynid/common/message.hpp"
 #include "dynid/dynamics/rnea.hpp"
+#include "dynid/estimation/parameter_drift.hpp"
 #include "dynid/identifiability/base_parameters.hpp"
 #include "dynid/identification/identify.hpp"
+#include "dynid/identification/streaming_partial.hpp"
 #include "dynid/identification/validation.hpp"
 #include "dynid/io/atomic_file.hpp"
 #include "dynid/io/model_summary.hpp"
@@ -29,6 +31,7 @@
 #include "dynid/physical/physical_parameters.hpp"
 #include "dynid/physical/urdf_export.hpp"
 #include "dynid/regressor/torque_regressor.hpp"
+#include "dynid/report/drift_report.hpp"
 #include "dynid/report/experiment_report.hpp"
 #include "dynid/report/html_report.hpp"
 #include "dynid/report/identification_report.hpp"
@@ -456,6 +459,142 @@ nlohmann::json payload_from_torques(const Model& model, const std::string& link_
 }  // namespace dynid
 
 // The compiled half of the Python package dynid (python/dynid/__init__.py re-exports it).
+namespace dynid {
+
+// Issue 31 (python/dynid/fleet.py): the per-file partial state of the stream, its exact merge and
+// solve, and the drift comparison. Parts travel as the bytes of the .dpart format, which is what
+// crosses a cluster's network (never the samples).
+void bind_fleet(py::module_& m) {
+  m.def(
+      "stream_partial",
+      [](const Model& model, const std::vector<std::string>& files, const std::string& robot,
+         bool armature, bool viscous, bool coulomb, bool offset, bool asymmetric,
+         const std::string& estimator, double confidence, const std::vector<double>& zero_velocity,
+         bool householder, int threads) {
+        if (estimator != "ols" && estimator != "wls") {
+          throw Error("estimator must be 'ols' or 'wls' for a streamed part, not '" + estimator +
+                      "'");
+        }
+        if (!(confidence > 0.0 && confidence < 1.0)) {
+          throw Error("confidence must be in (0, 1), e.g. 0.999");
+        }
+        IdentifyOptions o;
+        o.layout = layout_of(armature, viscous, coulomb, offset, asymmetric);
+        o.estimator =
+            estimator == "wls" ? IdentificationEstimator::kWls : IdentificationEstimator::kOls;
+        o.confidence_level = confidence;
+        o.signal.filter = false;
+        o.signal.zero_velocity = zero_velocity;
+        std::string bytes;
+        {
+          py::gil_scoped_release release;
+          StreamPartial part = stream_partial(model, files, {}, o, {threads, !householder});
+          part.options = {{"armature", armature},
+                          {"viscous", viscous},
+                          {"coulomb", coulomb},
+                          {"offset", offset},
+                          {"asymmetric", asymmetric},
+                          {"estimator", estimator},
+                          {"confidence_level", confidence},
+                          {"zero_velocity", zero_velocity},
+                          {"filter", false}};
+          part.origin = stream_partial_origin(robot.empty() ? model.name : robot, model);
+          bytes = stream_partial_bytes(part);
+        }
+        return py::bytes(bytes);
+      },
+      py::arg("model"), py::arg("files"), py::arg("robot") = "", py::arg("armature") = true,
+      py::arg("viscous") = true, py::arg("coulomb") = true, py::arg("offset") = true,
+      py::arg("asymmetric") = false, py::arg("estimator") = "ols", py::arg("confidence") = 0.999,
+      py::arg("zero_velocity") = std::vector<double>{}, py::arg("householder") = false,
+      py::arg("threads") = 1,
+      "The accumulated least-squares state of CSV runs read in constant memory, as 'dynid "
+      "identify --stream --partial' writes it (bytes of the .dpart format, docs/methods/fleet.md): "
+      "files (q*, dq*, ddq*, tau* columns, no filtering), robot (the name or path model was "
+      "loaded from, stored so that solve_partial can load it again), the per-joint columns, "
+      "estimator ('ols', 'wls'), confidence, zero_velocity [rad/s] (1 or n values), householder "
+      "(Householder QR instead of normal equations), threads (per file).");
+  m.def(
+      "merge_partials",
+      [](const std::vector<std::string>& parts) {
+        if (parts.empty()) throw Error("merge_partials needs at least one part");
+        std::string bytes;
+        {
+          py::gil_scoped_release release;
+          StreamPartial merged = stream_partial_from_bytes(parts.front(), "part 1");
+          for (std::size_t i = 1; i < parts.size(); ++i) {
+            merge_stream_partials(
+                merged, stream_partial_from_bytes(parts[i], "part " + std::to_string(i + 1)),
+                "part 1", "part " + std::to_string(i + 1));
+          }
+          bytes = stream_partial_bytes(merged);
+        }
+        return py::bytes(bytes);
+      },
+      py::arg("parts"),
+      "Merges parts (bytes of stream_partial or merge_partials) exactly into one part, as 'dynid "
+      "merge --partial'; refuses parts of another robot or option set (dynid.Error).");
+  m.def(
+      "solve_partial",
+      [](const std::string& bytes, const std::optional<Model>& model) {
+        const StreamPartial part = stream_partial_from_bytes(bytes, "part");
+        JointSelection selection;
+        std::string robot = stream_partial_robot(part, selection);
+        Model loaded;
+        if (model) {
+          loaded = *model;
+          robot = model->name;
+        } else {
+          RobotOptions options;
+          options.selection = selection;
+          loaded = load_robot(robot, options).model;
+        }
+        py::gil_scoped_release release;
+        const IdentificationResult result = solve_stream_partial(loaded, part);
+        const nlohmann::json out =
+            identification_to_json(loaded, result, stream_partial_result_options(part, robot));
+        py::gil_scoped_acquire acquire;
+        return to_python(out);
+      },
+      py::arg("part"), py::arg("model") = py::none(),
+      "Solves a part as 'dynid merge --out' does and returns the result dict (the keys of the "
+      "result JSON); model: the robot (default: the one the part names, loaded here).");
+  m.def(
+      "compare",
+      [](const std::vector<py::dict>& results, double alpha, std::vector<std::string> labels) {
+        if (!labels.empty() && labels.size() != results.size()) {
+          throw Error("labels: give one per result or none");
+        }
+        std::vector<DriftInput> inputs;
+        std::vector<std::string> covariances, robots;
+        for (std::size_t i = 0; i < results.size(); ++i) {
+          if (labels.size() < results.size()) labels.push_back("result " + std::to_string(i));
+          const nlohmann::json j = nlohmann::json::parse(
+              py::module_::import("json").attr("dumps")(results[i]).cast<std::string>());
+          std::string covariance;
+          inputs.push_back(drift_input_of_result(j, labels[i], &covariance));
+          covariances.push_back(covariance);
+          robots.push_back(robot_of_result(j));
+          if (!robots.back().empty() && !robots.front().empty() &&
+              robots.back() != robots.front()) {
+            throw Error(labels[i] + " is a result of robot '" + robots.back() + "', " + labels[0] +
+                        " of '" + robots.front() + "'; compare results of one robot type");
+          }
+        }
+        DriftOptions options;
+        options.alpha = alpha;
+        const DriftComparison c = compare_estimates(inputs, options);
+        return to_python(drift_to_json(inputs, covariances, robots, c));
+      },
+      py::arg("results"), py::arg("alpha") = 0.01, py::arg("labels") = std::vector<std::string>{},
+      "Per parameter, the change of each later result against the first, its standard deviation "
+      "from both results, the z-score and Holm's verdict at the family-wise false-alarm rate "
+      "alpha, as 'dynid compare --json' (results: dicts of identify, solve_partial or payload, "
+      "or result JSONs loaded with json.load).");
+}
+
+}  // namespace dynid
+
 PYBIND11_MODULE(_core, m) {
   using namespace dynid;
   using namespace dynid::binding;
@@ -722,4 +861,5 @@ PYBIND11_MODULE(_core, m) {
   // One function per binding area, each in its own translation unit (python/bind_*.cpp).
   bind_identification(m);
   bind_experiments(m);
+  dynid::bind_fleet(m);
 }

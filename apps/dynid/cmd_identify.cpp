@@ -21,7 +21,9 @@
 #include "dynid/identification/identify.hpp"
 #include "dynid/identification/option_text.hpp"
 #include "dynid/identification/streaming_identification.hpp"
+#include "dynid/identification/streaming_partial.hpp"
 #include "dynid/identification/validation.hpp"
+#include "dynid/io/atomic_file.hpp"
 #include "dynid/io/closed_loop_file.hpp"
 #include "dynid/io/joint_record_file.hpp"
 #include "dynid/io/joint_state_log.hpp"
@@ -40,6 +42,7 @@
 #include "dynid/sim/simulate_reference.hpp"
 #include "dynid/workflow/identify_runs.hpp"
 #include "flag_checks.hpp"
+#include "partial_support.hpp"
 #include "robot_flags.hpp"
 #include "run_flags.hpp"
 
@@ -62,6 +65,8 @@ struct IdentifyCliOptions {
   bool savgol = false;
   bool stream = false;
   int threads = 0;
+  std::string partial;       // --partial (with --stream): the accumulated state, for dynid merge
+  bool householder = false;  // --householder (with --stream)
   bool filter_coulomb = false;
   std::vector<double> coulomb_width;  // --coulomb-width
   std::string outliers = "report";
@@ -397,9 +402,16 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   if (!o.history.empty() && options.estimator != IdentificationEstimator::kRls) {
     throw UsageError("--history needs --estimator rls (the batch estimators have no history)");
   }
-  if (o.stream && o.runs.size() > 1) {
-    throw UsageError("--stream reads one run; give one --data, or drop --stream to stack runs");
+  if (!o.stream && (!o.partial.empty() || o.householder)) {
+    throw UsageError("--partial and --householder are for --stream; add --stream or drop them");
   }
+  if (o.out.empty() && o.partial.empty()) {
+    throw UsageError("--out is required (with --stream, --partial alone is enough)");
+  }
+  if (o.out.empty() && (!o.report.empty() || o.physical)) {
+    throw UsageError("--report and --physical need --out (the result they describe)");
+  }
+  require_output_folder(o.partial, "--partial");
   if (o.stream && !o.history.empty()) {
     throw UsageError("--history needs the in-memory mode (drop --stream)");
   }
@@ -408,10 +420,11 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   require_output_folder(o.out, "--out");
   require_output_folder(o.history, "--history");
   require_output_folder(o.report, "--report");
-  if (o.stream && !o.runs.empty() &&
-      joint_state_log_format(o.runs.front()) != JointStateLogFormat::kNone) {
-    throw UsageError("--stream reads a CSV run in chunks; '" + o.runs.front() +
-                     "' is a ROS log, read in memory: drop --stream");
+  for (const auto& run : o.runs) {
+    if (o.stream && joint_state_log_format(run) != JointStateLogFormat::kNone) {
+      throw UsageError("--stream reads a CSV run in chunks; '" + run +
+                       "' is a ROS log, read in memory: drop --stream");
+    }
   }
   if (o.stream && (!o.run.torque_scale.empty() || !file.torque_bias.empty() ||
                    !file.window.empty() || columns_by_position(file.columns))) {
@@ -448,13 +461,29 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
   IdentifyRunsOptions run_options;
   run_options.repeat = o.repeat;
   run_options.physical = o.physical;
+  std::optional<OutputBatch> outputs;  // with --partial
   std::vector<JointRecord> records;
   std::optional<JointRecord> physical_run;
   if (o.stream) {
     // Reading the big file is the whole wait: the line counts its bytes.
     ProgressLine progress("identify", progress_wanted(o.quiet));
     options.progress = progress.callback();
-    result = identify_stream(model, o.data, file, options, {o.threads, true});
+    const StreamingIdentificationOptions stream{o.threads, !o.householder};
+    if (o.partial.empty()) {
+      result = identify_stream(model, o.runs, file, options, stream);
+    } else {
+      StreamPartial part = stream_partial(model, o.runs, file, options, stream);
+      part.options = partial_options(echo(o));
+      part.origin = stream_partial_origin(o.robot, model);
+      outputs.emplace();  // the part, the result and its report, or none of them
+      write_stream_partial(o.partial, part);
+      std::cout << "wrote " << o.partial << " (" << part.runs.size() << " runs)\n";
+      if (o.out.empty()) {
+        outputs->commit();
+        return;
+      }
+      result = solve_merged_part(model, part);
+    }
     progress.finish();
     options.progress = nullptr;  // it refers to this scope's line
     // The physical fit's torque errors are measured on the run, read here only for it.
@@ -517,6 +546,7 @@ void run_identify(IdentifyCliOptions o, const CLI::App& cmd) {
     std::cout << "wrote " << o.history << '\n';
   }
   write_report(o.report, o.out, out);
+  if (outputs) outputs->commit();
 }
 
 struct ValidateCliOptions {
@@ -699,7 +729,7 @@ void add_identify_command(CLI::App& app) {
       ->required()
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  cmd->add_option("--out,-o", o->out, "Result JSON file")->required();
+  cmd->add_option("--out,-o", o->out, "Result JSON file (optional with --stream --partial)");
   cmd->add_flag("--quiet,-q", o->quiet,
                 "No progress line on stderr (shown only when stderr is a terminal)");
   cmd->add_option("--report", o->report,
@@ -769,9 +799,19 @@ void add_identify_command(CLI::App& app) {
                   "Drop rows of joint j with |dq_j| below this [rad/s] (1 or n values); "
                   "default max(1 % of max|dq_j|, 3 x its noise std), Coulomb columns filtered")
       ->delimiter(',');
-  cmd->add_flag("--stream", o->stream,
-                "Constant-memory mode for very long runs: reads the file in chunks; needs q, dq, "
-                "ddq, tau columns and --filter none");
+  cmd->add_flag(
+      "--stream", o->stream,
+      "Constant-memory mode for very long runs: reads each --data file in chunks (several "
+      "files: the fit of all their rows); needs q, dq, ddq, tau columns and --filter "
+      "none");
+  cmd->add_option("--partial", o->partial,
+                  "With --stream: also write the accumulated least-squares state of the --data "
+                  "runs to this file (.dpart, docs/methods/fleet.md), for dynid merge; --out is "
+                  "then optional");
+  cmd->add_flag("--householder", o->householder,
+                "With --stream: accumulate Householder QR factors from the start instead of "
+                "normal equations (about 3x slower, backward stable): for parts whose merged "
+                "normal equations dynid merge finds too ill-conditioned");
   cmd->add_option("--threads", o->threads,
                   "With --stream: worker threads (0 = one per core); the result does not depend "
                   "on it beyond round-off")

@@ -20,6 +20,8 @@ void add_commands(CLI::App& app) {
   add_export_command(app);
   add_report_command(app);
   add_run_command(app);
+  add_merge_command(app);
+  add_compare_command(app);
   check_numeric_flags(app);
   check_file_flags(app);
 }

@@ -66,6 +66,11 @@ CompletedModel completed_model_from_result(const Model& model, const std::string
 void add_export_command(CLI::App& app);
 /// `dynid report`: self-contained HTML page with plots of result JSON files (cmd_report.cpp).
 void add_report_command(CLI::App& app);
+/// `dynid merge`: partial results of identify --stream --partial merged and solved
+/// (cmd_merge.cpp).
+void add_merge_command(CLI::App& app);
+/// `dynid compare`: per-parameter drift between identification results (cmd_compare.cpp).
+void add_compare_command(CLI::App& app);
 /// `dynid run`: a whole study from a YAML project file (cmd_run.cpp, workflow/project.hpp).
 void add_run_command(CLI::App& app);
 

@@ -32,3 +32,4 @@ try:
 except ImportError as _error:
     raise ImportError("dynid's compiled module dynid._core does not load here (built for "
                       f"another Python version?): {_interpreter_hint()}") from _error
+from . import fleet  # noqa: F401,E402  (dynid.fleet.identify: many logs on a Dask cluster)

@@ -303,6 +303,79 @@ void StreamingLeastSquares::merge(const StreamingLeastSquares& other) {
   rows_ += other.rows_;
 }
 
+StreamingState StreamingLeastSquares::state() const {
+  flush();
+  StreamingState s;
+  s.accumulation = options_.accumulation;
+  s.parameters = parameters_;
+  for (const Group& g : groups_) {
+    StreamingState::Group out;
+    out.columns.assign(g.columns.begin(), g.columns.end() - 1);
+    out.summary = g.summary.triangularView<Eigen::Upper>();
+    out.rows = g.rows;
+    s.groups.push_back(std::move(out));
+  }
+  return s;
+}
+
+StreamingLeastSquares StreamingLeastSquares::from_state(const StreamingState& state) {
+  if (state.groups.empty()) throw Error("streaming state: no row group; the state is corrupt");
+  StreamingOptions options;
+  options.accumulation = state.accumulation;
+  for (const auto& g : state.groups) options.group_columns.push_back(g.columns);
+  // The constructor checks p and the column lists.
+  StreamingLeastSquares out(state.parameters, static_cast<int>(state.groups.size()), options);
+  for (std::size_t i = 0; i < state.groups.size(); ++i) {
+    const StreamingState::Group& g = state.groups[i];
+    Group& mine = out.groups_[i];
+    const Eigen::Index q = mine.summary.rows();
+    const std::string which = "streaming state: group " + std::to_string(i);
+    if (g.summary.rows() != q || g.summary.cols() != q) {
+      throw Error(which + " has a " + std::to_string(g.summary.rows()) + "x" +
+                  std::to_string(g.summary.cols()) + " summary for " + std::to_string(q - 1) +
+                  " columns; the state is corrupt");
+    }
+    if (!g.summary.allFinite() ||
+        !g.summary.triangularView<Eigen::StrictlyLower>().toDenseMatrix().isZero(0.0)) {
+      throw Error(which +
+                  " has a summary that is not finite or not upper triangular; the state is "
+                  "corrupt");
+    }
+    if (g.rows < 0) throw Error(which + " has a negative row count; the state is corrupt");
+    mine.summary = g.summary;
+    mine.rows = g.rows;
+    out.rows_ += g.rows;
+  }
+  return out;
+}
+
+double StreamingLeastSquares::relative_error(const Eigen::Ref<const Eigen::VectorXd>& x) const {
+  if (x.size() != parameters_) {
+    throw Error("relative_error: x has " + std::to_string(x.size()) + " entries for " +
+                std::to_string(parameters_) + " parameters");
+  }
+  flush();
+  double rss = 0.0, yy = 0.0;
+  for (const Group& g : groups_) {
+    if (g.rows == 0) continue;
+    const auto pg = static_cast<Eigen::Index>(g.columns.size()) - 1;
+    Eigen::VectorXd xa(pg + 1);
+    for (Eigen::Index c = 0; c < pg; ++c) xa(c) = x(g.columns[c]);
+    xa(pg) = -1.0;
+    if (options_.accumulation == Accumulation::kHouseholder) {
+      rss += (g.summary.triangularView<Eigen::Upper>() * xa).squaredNorm();
+      yy += g.summary.col(pg).squaredNorm();
+    } else {
+      // ‖e_g‖² = [x; −1]ᵀ G_g [x; −1] straight from the Gram matrix: compact_factor() would drop
+      // the directions a single run leaves unexcited, which still carry residual.
+      rss += std::max(0.0, xa.dot(g.summary.selfadjointView<Eigen::Upper>() * xa));
+      yy += g.summary(pg, pg);
+    }
+  }
+  return yy > 0.0 ? std::sqrt(rss / yy)
+                  : (rss > 0.0 ? std::numeric_limits<double>::quiet_NaN() : 0.0);
+}
+
 double StreamingLeastSquares::normal_equations_condition(const Eigen::VectorXd& weights) const {
   flush();
   const Eigen::Index q = parameters_ + 1;

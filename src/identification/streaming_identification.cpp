@@ -1,5 +1,7 @@
 #include "dynid/identification/streaming_identification.hpp"
 
+#include "dynid/identification/streaming_partial.hpp"
+
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -35,19 +37,19 @@ constexpr Eigen::Index kStructuralCheckStride = 16;
 // Upper bound on worker threads.
 constexpr int kMaxThreads = 8;
 
-// Base columns (indices into base.base) that can be non-zero in each joint's torque row: the links
-// of the joint's subtree and the joint's own friction. Probed numerically at random states, since
-// an analytic function that vanishes at random points vanishes everywhere.
-std::vector<std::vector<Eigen::Index>> joint_base_columns(const Model& model,
-                                                          const ParameterLayout& layout,
-                                                          const BaseParameters& base) {
+// The base regressor (rows: joint j of probe k at row k·n + j) at kSparsityProbes random states;
+// velocities alternate in sign so that one-sided (asymmetric Coulomb) columns are seen as well.
+// It fixes which columns each joint sees, and it is the partial result's fingerprint of the
+// equations (kinematics, gravity, parameter set).
+Eigen::MatrixXd probe_base_regressor(const Model& model, const ParameterLayout& layout,
+                                     const BaseParameters& base) {
   const int n = model.dof();
   Workspace ws(model);
   Eigen::MatrixXd Y(n, layout.columns(n));
+  Eigen::MatrixXd out(n * kSparsityProbes, base.rank);
   Eigen::VectorXd q(n), dq(n), ddq(n);
   std::mt19937 rng(kSparsitySeed);
   std::uniform_real_distribution<double> angle(-3.0, 3.0), speed(0.2, 2.0);
-  std::vector<std::vector<char>> seen(n, std::vector<char>(base.rank, 0));
   for (int probe = 0; probe < kSparsityProbes; ++probe) {
     for (int j = 0; j < n; ++j) {
       q[j] = angle(rng);
@@ -55,13 +57,23 @@ std::vector<std::vector<Eigen::Index>> joint_base_columns(const Model& model,
       ddq[j] = angle(rng);
     }
     torque_regressor(model, ws, layout, q, dq, ddq, Y);
-    for (int j = 0; j < n; ++j)
-      for (int c = 0; c < base.rank; ++c) seen[j][c] |= Y(j, base.base[c]) != 0.0;
+    for (int c = 0; c < base.rank; ++c) out.block(probe * n, c, n, 1) = Y.col(base.base[c]);
   }
+  return out;
+}
+
+// Base columns (indices into base.base) that can be non-zero in each joint's torque row: the links
+// of the joint's subtree and the joint's own friction. Read off the probe, since an analytic
+// function that vanishes at random points vanishes everywhere.
+std::vector<std::vector<Eigen::Index>> joint_base_columns(const Eigen::MatrixXd& probe, int n) {
   std::vector<std::vector<Eigen::Index>> columns(n);
-  for (int j = 0; j < n; ++j)
-    for (int c = 0; c < base.rank; ++c)
-      if (seen[j][c]) columns[j].push_back(c);
+  for (int j = 0; j < n; ++j) {
+    for (Eigen::Index c = 0; c < probe.cols(); ++c) {
+      bool seen = false;
+      for (Eigen::Index r = j; r < probe.rows(); r += n) seen |= probe(r, c) != 0.0;
+      if (seen) columns[j].push_back(c);
+    }
+  }
   return columns;
 }
 
@@ -284,17 +296,16 @@ void reject_unsupported_signal_options(const SignalOptions& s) {
   }
 }
 
-}  // namespace
-
-IdentificationResult identify_stream(const Model& model, const std::string& path,
-                                     const RunFileOptions& file, const IdentifyOptions& options,
-                                     const StreamingIdentificationOptions& stream) {
+// The stream's checks of identify's options, before any file is opened.
+void check_stream_options(const IdentifyOptions& options,
+                          const StreamingIdentificationOptions& stream) {
   if (options.signal.filter) {
     throw UsageError(
         "streaming identification reads the file once and cannot filter it; use "
         "--filter none with dq and ddq columns, or drop --stream");
   }
-  if (options.estimator == IdentificationEstimator::kRls) {
+  if (options.estimator != IdentificationEstimator::kOls &&
+      options.estimator != IdentificationEstimator::kWls) {
     throw UsageError("streaming identification supports --estimator ols or wls");
   }
   reject_unsupported_signal_options(options.signal);
@@ -307,104 +318,230 @@ IdentificationResult identify_stream(const Model& model, const std::string& path
     throw UsageError("--threads is " + std::to_string(stream.threads) +
                      "; give 0 (one per core) or a positive count");
   }
-  const int n = model.dof();
-  IdentificationResult result;
+}
+
+BaseParameters stream_base_parameters(const Model& model, const IdentifyOptions& options) {
   BaseParameterOptions base_options = options.base;
   base_options.layout = options.layout;
-  result.base = compute_base_parameters(model, base_options);
-  result.names = result.base.names;
-  result.expressions = result.base.expressions;
-  result.unidentifiable = result.base.unidentifiable_names();
-  result.rank = result.base.rank;
-  const int rank = result.rank;
+  return compute_base_parameters(model, base_options);
+}
+
+// Column indices of q, dq, ddq and tau in `path`'s header, after the renames of `file`.
+void resolve_stream_columns(const Model& model, const std::string& path, const RunFileOptions& file,
+                            StreamSetup& s) {
+  CsvChunkReader header(path);
+  std::vector<std::string> columns = header.columns();
+  for (auto& name : columns) {
+    for (const auto& [from, to] : file.columns) {
+      if (name == from) name = to;
+    }
+  }
+  std::vector<std::string> joints;
+  for (const Joint& j : model.joints) joints.push_back(j.name);
+  for (const char* prefix : {"dq", "ddq"}) {
+    if (!has_joint_columns(columns, joints, prefix)) {
+      throw UsageError("'" + path + "' has no " + prefix +
+                       "* columns; streaming identification needs q, dq, ddq and tau on the "
+                       "joint side (drop --stream to derive them)");
+    }
+  }
+  s.cq = resolve_joint_columns(columns, joints, "q", path);
+  s.cdq = resolve_joint_columns(columns, joints, "dq", path);
+  s.cddq = resolve_joint_columns(columns, joints, "ddq", path);
+  s.ctau = resolve_joint_columns(columns, joints, "tau", path);
+}
+
+const char* accumulation_name(Accumulation a) {
+  return a == Accumulation::kNormalEquations ? "normal_equations" : "householder";
+}
+
+// stream_partial() that also tells the worker count it used (the result's `threads` choice);
+// `pass` + file name is what the progress callback is told.
+StreamPartial accumulate_runs(const Model& model, const std::vector<std::string>& paths,
+                              const RunFileOptions& file, const IdentifyOptions& options,
+                              const StreamingIdentificationOptions& stream, int& threads_used,
+                              const std::string& pass) {
+  check_stream_options(options, stream);
+  if (paths.empty()) throw UsageError("streaming identification needs at least one run file");
+  const int n = model.dof();
+  const BaseParameters base = stream_base_parameters(model, options);
+  const int rank = base.rank;
+  StreamPartial part;
+  part.probe = probe_base_regressor(model, options.layout, base);
 
   StreamSetup s;
   s.model = &model;
   s.layout = &options.layout;
-  s.base = &result.base;
-  s.path = path;
+  s.base = &base;
   s.block_bytes = stream.block_bytes;
-  {
-    CsvChunkReader header(path);
-    std::vector<std::string> columns = header.columns();
-    for (auto& name : columns) {
-      for (const auto& [from, to] : file.columns) {
-        if (name == from) name = to;
-      }
-    }
-    std::vector<std::string> joints;
-    for (const Joint& j : model.joints) joints.push_back(j.name);
-    for (const char* prefix : {"dq", "ddq"}) {
-      if (!has_joint_columns(columns, joints, prefix)) {
-        throw UsageError("'" + path + "' has no " + prefix +
-                         "* columns; streaming identification needs q, dq, ddq and tau on the "
-                         "joint side (drop --stream to derive them)");
-      }
-    }
-    s.cq = resolve_joint_columns(columns, joints, "q", path);
-    s.cdq = resolve_joint_columns(columns, joints, "dq", path);
-    s.cddq = resolve_joint_columns(columns, joints, "ddq", path);
-    s.ctau = resolve_joint_columns(columns, joints, "tau", path);
-  }
   s.threshold = given_zero_velocity(options.signal.zero_velocity, n);
   if (s.threshold.size() == 0) s.threshold = Eigen::VectorXd::Zero(n);  // no automatic rule here
-  s.active = joint_base_columns(model, options.layout, result.base);
+  s.active = joint_base_columns(part.probe, n);
   s.active_offset.resize(n);
   s.inactive_offset.resize(n);
   for (int j = 0; j < n; ++j) {
     for (Eigen::Index c = 0, a = 0; c < rank; ++c) {
       const bool active = a < static_cast<Eigen::Index>(s.active[j].size()) && s.active[j][a] == c;
-      (active ? s.active_offset[j] : s.inactive_offset[j]).push_back(result.base.base[c] * n + j);
+      (active ? s.active_offset[j] : s.inactive_offset[j]).push_back(base.base[c] * n + j);
       a += active;
     }
   }
-  int threads =
-      stream.threads > 0
-          ? std::min(stream.threads, kMaxThreads)
-          : std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, kMaxThreads);
   StreamingOptions lsq_options;
   lsq_options.group_columns = s.active;
   lsq_options.accumulation =
       stream.normal_equations ? Accumulation::kNormalEquations : Accumulation::kHouseholder;
 
+  std::vector<std::string> joints;
+  for (const Joint& j : model.joints) joints.push_back(j.name);
+  const ParameterLayout& l = options.layout;
+  part.identity = {
+      {"robot", model.name},
+      {"joints", joints},
+      {"parameters", base.names},
+      {"layout",
+       {{"armature", l.armature},
+        {"viscous", l.viscous},
+        {"coulomb", l.coulomb},
+        {"offset", l.offset},
+        {"asymmetric", l.asymmetric},
+        {"coupling", options.coupling}}},
+      {"estimator", options.estimator == IdentificationEstimator::kWls ? "wls" : "ols"},
+      {"confidence_level", options.confidence_level},
+      {"zero_velocity_threshold",
+       std::vector<double>(s.threshold.data(), s.threshold.data() + s.threshold.size())},
+      {"accumulation", accumulation_name(lsq_options.accumulation)}};
+
+  threads_used = 0;
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    s.path = paths[i];
+    resolve_stream_columns(model, s.path, file, s);
+    int threads =
+        stream.threads > 0
+            ? std::min(stream.threads, kMaxThreads)
+            : std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, kMaxThreads);
+    // Each file's share of the progress line, so that it runs once from 0 to 1.
+    ProgressCallback progress;
+    if (options.progress) {
+      const double files = static_cast<double>(paths.size());
+      progress = [&options, i, files](double fraction, const std::string& what) {
+        options.progress((static_cast<double>(i) + fraction) / files, what);
+      };
+    }
+    StreamRun run;
+    run.file = s.path;
+    const StreamingLeastSquares lsq =
+        accumulate(s, lsq_options, threads, run.samples, progress, pass + s.path);
+    threads_used = std::max(threads_used, threads);
+    run.state = lsq.state();
+    part.runs.push_back(std::move(run));
+  }
+  return part;
+}
+
+std::string first_pass(const StreamingIdentificationOptions& stream) {
+  return stream.normal_equations ? "reading " : "Householder QR pass over ";
+}
+
+}  // namespace
+
+StreamPartial stream_partial(const Model& model, const std::vector<std::string>& paths,
+                             const RunFileOptions& file, const IdentifyOptions& options,
+                             const StreamingIdentificationOptions& stream) {
+  int threads = 0;
+  return accumulate_runs(model, paths, file, options, stream, threads, first_pass(stream));
+}
+
+IdentifyOptions stream_partial_options(const StreamPartial& part) {
+  IdentifyOptions o;
+  try {
+    const nlohmann::json& id = part.identity;
+    const nlohmann::json& l = id.at("layout");
+    o.layout = ParameterLayout::rigid();
+    o.layout.armature = l.at("armature").get<bool>();
+    o.layout.viscous = l.at("viscous").get<bool>();
+    o.layout.coulomb = l.at("coulomb").get<bool>();
+    o.layout.offset = l.at("offset").get<bool>();
+    o.layout.asymmetric = l.at("asymmetric").get<bool>();
+    o.coupling = l.at("coupling").get<bool>();
+    const std::string estimator = id.at("estimator").get<std::string>();
+    if (estimator != "ols" && estimator != "wls") throw Error("estimator '" + estimator + "'");
+    o.estimator =
+        estimator == "wls" ? IdentificationEstimator::kWls : IdentificationEstimator::kOls;
+    o.confidence_level = id.at("confidence_level").get<double>();
+    if (!(o.confidence_level > 0.0 && o.confidence_level < 1.0)) throw Error("confidence level");
+    o.signal.zero_velocity = id.at("zero_velocity_threshold").get<std::vector<double>>();
+    for (double v : o.signal.zero_velocity)
+      if (!(v >= 0.0 && std::isfinite(v))) throw Error("zero-velocity threshold");
+  } catch (const std::exception& e) {
+    throw Error(std::string("partial result: malformed identity (") + e.what() +
+                "); re-make the part with dynid identify --stream --partial");
+  }
+  o.signal.filter = false;
+  return o;
+}
+
+IdentificationResult solve_stream_partial(const Model& model, const StreamPartial& part) {
+  if (part.runs.empty()) throw Error("partial result: no run to solve; the part is corrupt");
+  const IdentifyOptions options = stream_partial_options(part);
+  const int n = model.dof();
+  IdentificationResult result;
+  result.base = stream_base_parameters(model, options);
+  // The model given must make the equations the part was accumulated with.
+  std::vector<std::string> joints;
+  for (const Joint& j : model.joints) joints.push_back(j.name);
+  const Eigen::MatrixXd probe = probe_base_regressor(model, options.layout, result.base);
+  const double scale = std::max(1.0, part.probe.cwiseAbs().maxCoeff());
+  if (part.identity.value("robot", "") != model.name ||
+      part.identity.value("joints", nlohmann::json::array()) != nlohmann::json(joints) ||
+      part.identity.value("parameters", nlohmann::json::array()) !=
+          nlohmann::json(result.base.names) ||
+      probe.rows() != part.probe.rows() || probe.cols() != part.probe.cols() ||
+      !((probe - part.probe).cwiseAbs().maxCoeff() <= 1e-9 * scale)) {
+    throw Error("the partial result was accumulated on robot '" + part.identity.value("robot", "") +
+                "' with other equations than robot '" + model.name +
+                "' makes (joints, parameter set or kinematics differ); give the robot the parts "
+                "were made with");
+  }
+  result.names = result.base.names;
+  result.expressions = result.base.expressions;
+  result.unidentifiable = result.base.unidentifiable_names();
+  result.rank = result.base.rank;
+  StreamingLeastSquares lsq = StreamingLeastSquares::from_state(part.runs.front().state);
+  Eigen::Index samples = part.runs.front().samples;
+  for (std::size_t i = 1; i < part.runs.size(); ++i) {
+    lsq.merge(StreamingLeastSquares::from_state(part.runs[i].state));
+    samples += part.runs[i].samples;
+  }
+  if (lsq.parameters() != result.rank || lsq.groups() != n) {
+    throw Error("partial result: its state has " + std::to_string(lsq.parameters()) +
+                " parameters in " + std::to_string(lsq.groups()) + " groups for " +
+                std::to_string(result.rank) + " base parameters of " + std::to_string(n) +
+                " joints; the part is corrupt");
+  }
+  if (lsq.rows() <= result.rank) {
+    const std::string where = part.runs.size() == 1 ? "'" + part.runs.front().file + "'"
+                                                    : std::to_string(part.runs.size()) + " runs";
+    throw Error("only " + std::to_string(lsq.rows()) + " equations in " + where + " for " +
+                std::to_string(result.rank) + " base parameters; record a longer run");
+  }
   EstimationOptions eo;
   eo.confidence_level = options.confidence_level;
   eo.names = result.names;
-  const auto solve = [&](const StreamingLeastSquares& lsq) {
-    if (lsq.rows() <= rank) {
-      throw Error("only " + std::to_string(lsq.rows()) + " equations in '" + path + "' for " +
-                  std::to_string(rank) + " base parameters; record a longer run");
-    }
-    return options.estimator == IdentificationEstimator::kWls ? lsq.solve_weighted(eo)
-                                                              : lsq.solve_ordinary(eo);
-  };
-  Eigen::Index samples = 0;
-  StreamingLeastSquares lsq =
-      accumulate(s, lsq_options, threads, samples, options.progress, "reading " + path);
-  std::string accumulation = stream.normal_equations
-                                 ? "normal equations (column-equilibrated condition of [W y] "
-                                   "within 1e5)"
-                                 : "Householder QR";
-  try {
-    result.estimate = solve(lsq);
-  } catch (const NormalEquationsError& e) {
-    lsq_options.accumulation = Accumulation::kHouseholder;
-    lsq = accumulate(s, lsq_options, threads, samples, options.progress,
-                     "second pass (Householder QR) over " + path);
-    result.estimate = solve(lsq);
-    accumulation = std::string("Householder QR, second pass: ") + e.what();
-  }
+  result.estimate = options.estimator == IdentificationEstimator::kWls ? lsq.solve_weighted(eo)
+                                                                       : lsq.solve_ordinary(eo);
+  const bool normal = lsq.state().accumulation == Accumulation::kNormalEquations;
   result.choices.emplace_back("mode",
                               "streaming (constant memory), no filtering, dq and ddq as given");
-  result.choices.emplace_back("accumulation", accumulation);
-  result.choices.emplace_back("threads", std::to_string(threads) +
-                                             " workers, each reading and parsing its own blocks of "
-                                             "the file");
-  result.zero_velocity_threshold = s.threshold;
+  result.choices.emplace_back("accumulation",
+                              normal ? "normal equations (column-equilibrated condition of [W y] "
+                                       "within 1e5)"
+                                     : "Householder QR");
   result.choices.emplace_back("covariance",
                               "white-noise sigma^2 (W^T W)^-1 (the stream keeps no residual "
                               "series for a HAC sandwich): too narrow if the residuals are "
                               "correlated; identify without --stream for intervals that allow it");
+  const Eigen::VectorXd threshold = given_zero_velocity(options.signal.zero_velocity, n);
+  result.zero_velocity_threshold = threshold.size() == n ? threshold : Eigen::VectorXd::Zero(n);
   result.samples = samples;
   result.rows = lsq.rows();
   result.residual_rms = result.estimate.group_rms;
@@ -415,14 +552,48 @@ IdentificationResult identify_stream(const Model& model, const std::string& path
   // The stream keeps no regressor to split off unexcited columns: its data rank is the solve's
   // numerical rank (unexcited parameters keep σ = inf here; identify without --stream names them).
   result.data_rank = static_cast<int>(result.estimate.summary.rank);
-  RunSummary run;
-  run.file = path;
-  run.samples = samples;
-  run.rows = result.rows;
-  run.relative_error = result.relative_error;
-  run.zero_velocity_threshold = s.threshold;
-  result.runs.push_back(run);
+  for (const StreamRun& r : part.runs) {
+    const StreamingLeastSquares run_lsq = StreamingLeastSquares::from_state(r.state);
+    RunSummary run;
+    run.file = r.file;
+    run.samples = r.samples;
+    run.rows = run_lsq.rows();
+    run.relative_error = run_lsq.relative_error(result.estimate.x);
+    run.zero_velocity_threshold = result.zero_velocity_threshold;
+    result.runs.push_back(run);
+  }
   return result;
+}
+
+IdentificationResult identify_stream(const Model& model, const std::vector<std::string>& paths,
+                                     const RunFileOptions& file, const IdentifyOptions& options,
+                                     const StreamingIdentificationOptions& stream) {
+  int threads = 0;
+  StreamPartial part =
+      accumulate_runs(model, paths, file, options, stream, threads, first_pass(stream));
+  IdentificationResult result;
+  try {
+    result = solve_stream_partial(model, part);
+  } catch (const NormalEquationsError& e) {
+    StreamingIdentificationOptions householder = stream;
+    householder.normal_equations = false;
+    part = accumulate_runs(model, paths, file, options, householder, threads,
+                           "second pass (Householder QR) over ");
+    result = solve_stream_partial(model, part);
+    for (auto& [key, value] : result.choices) {
+      if (key == "accumulation") value = std::string("Householder QR, second pass: ") + e.what();
+    }
+  }
+  result.choices.emplace_back("threads", std::to_string(threads) +
+                                             " workers, each reading and parsing its own blocks of "
+                                             "the file");
+  return result;
+}
+
+IdentificationResult identify_stream(const Model& model, const std::string& path,
+                                     const RunFileOptions& file, const IdentifyOptions& options,
+                                     const StreamingIdentificationOptions& stream) {
+  return identify_stream(model, std::vector<std::string>{path}, file, options, stream);
 }
 
 }  // namespace dynid

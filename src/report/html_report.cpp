@@ -621,6 +621,87 @@ Json experiment_section(const ReportInput& in, const std::string& model) {
   return s;
 }
 
+// `dynid compare` (issue 31 item 3): the flagged changes first (friction and payload named), the
+// z-scores of the last result against the baseline with the first step's critical value, and
+// with more than two results each flagged (or friction / payload) parameter's trend with ±2σ.
+Json compare_section(const ReportInput& in) {
+  const Json& r = in.result;
+  Json s = new_section(in, "compare", "Drift: parameter changes against the baseline");
+  const Json& results = r.value("results", Json::array());
+  add_fact(s, "baseline", results.empty() ? "?" : text_of(results[0].value("file", Json("?"))));
+  add_fact(s, "results compared", text_of(Json(results.size())));
+  add_fact(s, "tests (parameter × later result)", text_of(r.value("tests", Json())));
+  add_fact(s, "family-wise false-alarm rate (Holm)", text_of(r.value("alpha", Json())));
+  add_fact(s, "first-step critical |z|",
+           text_of(rounded(number_or_nan(r.value("first_critical_z", Json())), 4)));
+  add_fact(s, "friction changes", joined(r.value("flagged_friction", Json::array())));
+  add_fact(s, "payload changes", joined(r.value("flagged_payload", Json::array())));
+  for (const auto& res : results) {
+    const std::string cov = text_of(res.value("covariance", Json("")));
+    if (cov.rfind("white", 0) == 0) {
+      s["warnings"].push_back(text_of(res.value("file", Json("?"))) +
+                              ": white-noise σ (streamed or merged result), too narrow if its "
+                              "residuals are correlated");
+    }
+  }
+  Json rows = Json::array();
+  for (const auto& f : r.value("flagged", Json::array())) {
+    rows.push_back({text_of(f.value("file", Json("?"))), text_of(f.value("name", Json("?"))),
+                    text_of(f.value("role", Json("?"))),
+                    text_of(rounded(number_or_nan(f.value("change", Json())), 5)),
+                    text_of(rounded(number_or_nan(f.value("std", Json())), 4)),
+                    text_of(rounded(number_or_nan(f.value("z", Json())), 4)),
+                    text_of(rounded(number_or_nan(f.value("p_adjusted", Json())), 3))});
+  }
+  if (rows.empty()) add_fact(s, "verdict", "no significant change");
+  s["tables"].push_back(
+      {{"title", "Significant changes"},
+       {"columns", {"result", "parameter", "role", "change", "std", "z", "adjusted p"}},
+       {"rows", rows}});
+  const Json& params = r.value("parameters", Json::array());
+  Json labels = Json::array(), zs = Json::array();
+  for (const auto& p : params) {
+    const Json& comparisons = p.value("comparisons", Json::array());
+    if (comparisons.empty()) continue;
+    labels.push_back(text_of(p.value("name", Json("?"))));
+    zs.push_back(rounded(number_or_nan(comparisons.back().value("z", Json())), 4));
+  }
+  if (!labels.empty()) {
+    s["charts"].push_back(
+        {{"title", "z-score of each parameter's change, last result against the baseline"},
+         {"type", "bar"},
+         {"y_label", "z"},
+         {"labels", labels},
+         {"wide", true},
+         {"series", {{{"label", "z"}, {"y", zs}, {"kind", "bar"}}}}});
+  }
+  if (results.size() <= 2) return s;
+  for (const auto& p : params) {
+    const std::string role = text_of(p.value("role", Json("")));
+    bool flagged = false;
+    for (const auto& c : p.value("comparisons", Json::array()))
+      flagged |= c.value("flagged", false);
+    if (!flagged && role != "friction" && role != "payload") continue;
+    const std::vector<double> v = numbers_of(p.value("values", Json()));
+    const std::vector<double> sd = numbers_of(p.value("std", Json()));
+    std::vector<double> x(v.size()), up(v.size()), down(v.size());
+    for (size_t i = 0; i < v.size(); ++i) {
+      x[i] = static_cast<double>(i);
+      const double si = i < sd.size() ? sd[i] : std::numeric_limits<double>::quiet_NaN();
+      up[i] = v[i] + 2 * si;
+      down[i] = v[i] - 2 * si;
+    }
+    const std::string name = text_of(p.value("name", Json("?")));
+    Json chart = line_chart("Trend of " + name + (flagged ? " (flagged)" : ""),
+                            "result (0 = baseline)", name,
+                            {series("estimate", x, v, "points"), series("+2σ", x, up, "dashed"),
+                             series("−2σ", x, down, "dashed")});
+    chart["small"] = true;
+    s["charts"].push_back(chart);
+  }
+  return s;
+}
+
 Json generic_section(const ReportInput& in) {
   const Json& r = in.result;
   Json s = new_section(in, "generic", "Result");
@@ -817,6 +898,7 @@ std::string read_text(const std::string& path, const std::string& what) {
 std::string result_kind(const nlohmann::json& r) {
   if (!r.is_object()) return "generic";
   if (r.value("command", Json()) == "payload") return "payload";
+  if (r.value("command", Json()) == "compare") return "compare";
   if (r.contains("criterion") && r.contains("coefficients")) return "excite";
   if (r.contains("channels") && r.contains("periods")) return "average";
   if (r.contains("controllers") && r["controllers"].is_array()) return "compare-control";
@@ -875,6 +957,8 @@ std::string html_report(const std::vector<ReportInput>& inputs, const HtmlReport
         section = excite_section(in);
       else if (kind == "compare-control")
         section = control_section(in);
+      else if (kind == "compare")
+        section = compare_section(in);
       else if (kind == "experiment")
         section = experiment_section(in, in.result["options"]["model"]);
       else

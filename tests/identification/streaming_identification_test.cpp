@@ -13,6 +13,7 @@
 #include "dynid/io/csv_chunk_reader.hpp"
 #include "dynid/io/csv_writer.hpp"
 #include "dynid/model/robots.hpp"
+#include "support/stream_runs.hpp"
 
 namespace dynid {
 namespace {
@@ -21,30 +22,7 @@ namespace {
 // in-memory identification must give the same estimate and statistics.
 std::string write_run(const Model& model, int samples, double sigma = 0.3,
                       const std::string& name = "stream_run.csv") {
-  std::mt19937 rng(9);
-  std::normal_distribution<double> noise(0.0, sigma);
-  const int n = model.dof();
-  std::vector<std::string> cols = {"t"};
-  for (const char* p : {"q", "dq", "ddq", "tau"})
-    for (int j = 0; j < n; ++j) cols.push_back(p + std::to_string(j + 1));
-  Eigen::MatrixXd data(samples, 1 + 4 * n);
-  Workspace ws(model);
-  Eigen::VectorXd q(n), dq(n), ddq(n), tau(n);
-  for (int k = 0; k < samples; ++k) {
-    const double t = 0.01 * k;
-    for (int j = 0; j < n; ++j) {
-      const double w = 0.5 + 0.3 * j;
-      q[j] = std::sin(w * t + j) + 0.3 * std::sin(3 * w * t);
-      dq[j] = w * std::cos(w * t + j) + 0.9 * w * std::cos(3 * w * t);
-      ddq[j] = -w * w * std::sin(w * t + j) - 2.7 * w * w * std::sin(3 * w * t);
-    }
-    rnea(model, ws, q, dq, ddq, tau);
-    for (int j = 0; j < n; ++j) tau[j] += noise(rng);
-    data.row(k) << t, q.transpose(), dq.transpose(), ddq.transpose(), tau.transpose();
-  }
-  const std::string path = ::testing::TempDir() + "/" + name;
-  write_csv(path, cols, data);
-  return path;
+  return testing::write_stream_run(model, samples, sigma, name);
 }
 
 TEST(StreamingIdentification, EqualsInMemoryIdentification) {

@@ -44,6 +44,21 @@ class NormalEquationsError : public Error {
   using Error::Error;
 };
 
+/// The accumulated content of a StreamingLeastSquares, for storage and exact merging elsewhere
+/// (partial results of identify --stream, streaming_partial.hpp): everything solve_* reads.
+struct StreamingState {
+  Accumulation accumulation = Accumulation::kHouseholder;  ///< how `summary` was accumulated
+  Eigen::Index parameters = 0;                             ///< p
+  struct Group {
+    std::vector<Eigen::Index> columns;  ///< the p_g columns kept (sorted), without the y column
+    /// (p_g+1)×(p_g+1): upper-triangular factor R_g of [W_g y_g] (kHouseholder) or the upper
+    /// triangle of its Gram matrix (kNormalEquations); the strict lower triangle is zero.
+    Eigen::MatrixXd summary;
+    Eigen::Index rows = 0;  ///< rows folded into summary
+  };
+  std::vector<Group> groups;  ///< one per row group (joint)
+};
+
 /// Least squares of y = W·x + e accumulated block by block in O(G·(p+1)²) memory, independent of
 /// the number of rows: for every row group g (joint) it keeps the upper-triangular factor R_g of
 /// [W_g y_g] (the "extra column" trick: R_g = [R_gp z_g; 0 ρ_g], R_gpᵀR_gp = W_gᵀW_g,
@@ -83,6 +98,20 @@ class StreamingLeastSquares {
   /// Adds the rows accumulated by `other` (same parameters, groups and options), as if they had
   /// been added here. Throws dynid::Error on a mismatch.
   void merge(const StreamingLeastSquares& other);
+
+  /// The accumulated state (pending rows folded in first): what a partial result stores.
+  StreamingState state() const;
+
+  /// An accumulator holding `state`, as if its rows had been added to a new one with
+  /// group_columns = the state's columns. Throws dynid::Error when the state is inconsistent
+  /// (p < 1, no group, columns not sorted in [0, p), summary of the wrong size, not finite or not
+  /// upper triangular, negative rows): a corrupt stored state is refused, not solved.
+  static StreamingLeastSquares from_state(const StreamingState& state);
+
+  /// ‖y − W·x‖/‖y‖ over every row added, from the factors (‖e_g‖ = ‖R_g·[x_g; −1]‖), with x from
+  /// another accumulator's solve (a run's share of a joint fit); NaN when ‖y‖ = 0 and the
+  /// residual is not. Throws dynid::Error when x does not have p entries.
+  double relative_error(const Eigen::Ref<const Eigen::VectorXd>& x) const;
 
   /// Ordinary least squares from the accumulated factor (rank, condition number, statistics).
   /// Throws dynid::Error if fewer rows than parameters were added, and NormalEquationsError with

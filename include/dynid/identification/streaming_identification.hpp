@@ -1,6 +1,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "dynid/identification/identify.hpp"
 #include "dynid/io/joint_record_file.hpp"
@@ -38,6 +39,14 @@ struct StreamingIdentificationOptions {
 /// Householder pass starts again from 0 and says so).
 /// Throws dynid::Error naming the file row for NaN/Inf samples and malformed lines.
 IdentificationResult identify_stream(const Model& model, const std::string& path,
+                                     const RunFileOptions& file, const IdentifyOptions& options,
+                                     const StreamingIdentificationOptions& stream = {});
+
+/// identify_stream over several runs (files), each read as above; the fit is that of all their
+/// rows (no row spans two files, so this is the stream over the concatenated runs) and
+/// IdentificationResult::runs has one entry per file with its relative error at the joint
+/// estimate. Throws as identify_stream, and dynid::UsageError for an empty `paths`.
+IdentificationResult identify_stream(const Model& model, const std::vector<std::string>& paths,
                                      const RunFileOptions& file, const IdentifyOptions& options,
                                      const StreamingIdentificationOptions& stream = {});
 

@@ -31,7 +31,8 @@ struct ReportInput {
 /// What a result JSON is, from the keys the commands write (docs/cli.md): identify (differential
 /// or integral), validate (torque), validate-simulation, payload, average, excite,
 /// compare-control, experiment
-/// (identify --model gravity|friction|decoupled); "generic" for anything else.
+/// (identify --model gravity|friction|decoupled), compare (dynid compare); "generic" for anything
+/// else.
 std::string result_kind(const nlohmann::json& result);
 
 /// Reads a result JSON for the report. Throws dynid::Error naming the file when it cannot be read
@@ -45,7 +46,7 @@ ReportInput read_report_input(const std::string& path);
 /// Gaussian with its Kolmogorov–Smirnov test, seed 2 Figs. 5 and 8; RLS histories, seed 1 Figs. 6
 /// and 8; the integral model's energy fit, seed 1 Fig. 5; an excitation's trajectory and line
 /// spectrum; the fits of the dedicated experiments; compare-control's tracking errors per
-/// controller and joint, seed 2 Fig. 9).
+/// controller and joint, seed 2 Fig. 9; dynid compare's flagged changes, z-scores and trends).
 /// Each chart reports itself to the page (body data-charts, data-points, data-empty-charts,
 /// data-errors, data-report-status = ok when every chart has points and no script failed).
 /// Throws dynid::Error when the Chart.js bundle cannot be read (install libjs-chart.js).
