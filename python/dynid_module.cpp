@@ -141,7 +141,7 @@ RowMatrix inverse_dynamics(const Model& model, const Samples& q, const Samples& 
 }
 
 // The load equations and estimator shared by the sensor modes of payload (`dynid payload`'s
-// --model, --static, --interval, --bias, --wrench-sign, --estimator, --confidence).
+// --model, --static, --interval, --components, --bias, --wrench-sign, --estimator, --confidence).
 struct LoadKeywords {
   LoadEquationOptions equations;
   LoadIdentificationOptions options;
@@ -166,6 +166,10 @@ LoadKeywords load_keywords(const Get& get) {
   if (!(k.equations.interval > 0.0))
     throw py::value_error("interval must be a positive window [s]");
   k.equations.bias = get("bias", false);
+  const std::string components = get("components", std::string());
+  if (!components.empty()) {
+    k.equations.components = load_components_from_text(components, "components");
+  }
   k.equations.wrench_sign = get("wrench_sign", 1.0);
   if (!(k.equations.wrench_sign == 1.0 || k.equations.wrench_sign == -1.0)) {
     throw py::value_error(
@@ -228,6 +232,7 @@ nlohmann::json solve_load(const SensorMotion& motion, const Eigen::MatrixXd& wre
   context.extra = {{"wrench_sign", k.equations.wrench_sign}};
   if (k.equations.model == LoadModelKind::kIntegral)
     context.extra["interval"] = k.equations.interval;
+  context.extra["components"] = block.group_names;
   context.group_names = block.group_names;
   context.with_inertia = k.equations.model != LoadModelKind::kStatic;
   context.choices = choices;
@@ -240,9 +245,9 @@ nlohmann::json payload(const Model& model, const std::string& sensor_link,
                        const std::optional<Eigen::VectorXd>& t, const Samples& q,
                        const Samples& wrench, const std::optional<RowMatrix>& dq,
                        const std::optional<RowMatrix>& ddq, const py::kwargs& kw) {
-  static const char* const kKeys[] = {"sensor_pose", "equations",   "interval",
-                                      "bias",        "wrench_sign", "estimator",
-                                      "confidence",  "cutoff_hz",   "filter"};
+  static const char* const kKeys[] = {"sensor_pose", "equations",   "interval",  "bias",
+                                      "components",  "wrench_sign", "estimator", "confidence",
+                                      "cutoff_hz",   "filter"};
   check_keywords(kw, kKeys);
   const auto get = keyword_getter(kw);
   LoadKeywords k = load_keywords(get);
@@ -299,8 +304,8 @@ nlohmann::json payload_from_orientation(const std::optional<Eigen::VectorXd>& t,
                                         const std::optional<RowMatrix>& w,
                                         const std::optional<RowMatrix>& dw,
                                         const std::optional<RowMatrix>& a, const py::kwargs& kw) {
-  static const char* const kKeys[] = {"equations", "interval",   "bias",   "wrench_sign",
-                                      "estimator", "confidence", "gravity"};
+  static const char* const kKeys[] = {"equations",   "interval",  "components", "bias",
+                                      "wrench_sign", "estimator", "confidence", "gravity"};
   check_keywords(kw, kKeys);
   const auto get = keyword_getter(kw);
   const LoadKeywords k = load_keywords(get);

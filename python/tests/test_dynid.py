@@ -234,6 +234,17 @@ def test_payload_recovers_a_load_on_the_forearm_within_its_intervals(planar2):
         assert values[name]["ci_low"] <= x <= values[name]["ci_high"], (values[name], x)
     # Planar motion turns the load about z only: Ixx, Iyy and the products are not all excited.
     assert sorted(result["not_excited"]) == ["Ixx", "Ixy", "Iyy"]
+    # The force equations alone (dynid payload --components): the mass and the in-plane centre
+    # of mass, every inertia and mcz named not excited.
+    forces = dynid.payload(planar2, "forearm", t, q, wrench, dq=dq, ddq=ddq, filter=False,
+                           components="fx,fy,fz")
+    assert forces["components"] == ["fx", "fy", "fz"]
+    values = {p["name"]: p for p in forces["parameters"]}
+    for name in ("m", "mcx", "mcy"):
+        assert values[name]["ci_low"] <= truth[name] <= values[name]["ci_high"], values[name]
+    assert sorted(forces["not_excited"]) == ["Ixx", "Ixy", "Ixz", "Iyy", "Iyz", "Izz", "mcz"]
+    with pytest.raises(dynid.Error, match="not a wrench component"):
+        dynid.payload(planar2, "forearm", t, q, wrench, components="fx,torque")
     with pytest.raises(TypeError, match="valid options are sensor_pose"):
         dynid.payload(planar2, "forearm", t, q, wrench, speed=1)
     with pytest.raises(dynid.Error, match="wrench must be"):
