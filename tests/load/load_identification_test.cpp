@@ -390,7 +390,7 @@ TEST(LoadIdentification, ForceOrMomentEquationsAloneGiveWhatTheyCarry) {
 // low-frequency measurement disturbances" — the integral model improved on a subset of eq. 29's
 // scalar equations. A strain-gauge moment drift (0.004 N·m/s on mx, my, mz, as temperature gives)
 // enters every moment row of ∫W dt; the force rows do not see it, so on the forces alone the mass
-// and centre of mass stay unbiased while all six equations pull mc outside its interval.
+// and centre of mass stay unbiased while on all six the drift biases what the moments carry.
 TEST(LoadIdentification, IntegralForcesAloneEscapeAMomentDrift) {
   const Eigen::VectorXd phi = table_one_load();
   const Rig rig = random_rig(phi, 11);
@@ -409,8 +409,13 @@ TEST(LoadIdentification, IntegralForcesAloneEscapeAMomentDrift) {
   const auto inside = [&](const LoadIdentificationResult& r, int j) {
     return r.estimate.ci_lower(j) <= phi(j) && phi(j) <= r.estimate.ci_upper(j);
   };
-  // All six: mcx +8.7 σ, mcy −10.3 σ off. Forces alone: m, mc within 1.1 σ.
-  EXPECT_FALSE(inside(a, 1) && inside(a, 2)) << a.estimate.x.head(4).transpose();
+  // Where the drift lands depends on the motion: on gcc's random arm all six equations put mcx at
+  // +8.7 σ, mcy at −10.3 σ and Ixx, Iyz, Izz beyond 3.6 σ; on clang's (its arguments are drawn in
+  // another order) Ixy, Ixz and Izz at 3.5–4 σ. Some estimate leaves its 99.9 % interval either
+  // way; on the forces alone m and mc stay within 1.3 σ on both.
+  int outside = 0;
+  for (int j = 0; j < 10; ++j) outside += !inside(a, j);
+  EXPECT_GT(outside, 0) << a.estimate.x.transpose();
   for (int j = 0; j < 4; ++j) EXPECT_TRUE(inside(f, j)) << j << ": " << f.estimate.x(j);
 }
 
