@@ -85,7 +85,10 @@ nlohmann::json drift_to_json(const std::vector<DriftInput>& inputs,
   const std::size_t later = inputs.size() - 1;
   for (std::size_t i = 0; i < c.rows.size(); i += later) {
     const ParameterDrift& first = c.rows[i];
-    nlohmann::json values = {json_number(first.before)}, stds = nlohmann::json::array();
+    // json::array() explicitly: `json v = {x}` with one json x is a copy under clang, an array
+    // under gcc (CWG 2137), so the later push_back threw on clang builds only.
+    nlohmann::json values = nlohmann::json::array(), stds = nlohmann::json::array();
+    values.push_back(json_number(first.before));
     const DriftInput& base = inputs.front();
     for (std::size_t k = 0; k < base.names.size(); ++k) {
       if (base.names[k] == first.name) stds.push_back(json_number(base.std_devs[k]));
