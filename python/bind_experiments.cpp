@@ -171,7 +171,7 @@ py::dict excite(const Model& model, const py::kwargs& kw) {
     py::dict out = to_python(e.json).cast<py::dict>();
     out["trajectory"] = trajectory_dict(e.samples);
     return out;
-  } catch (const UsageError& e) {
+  } catch (const Error& e) {  // a usage error or one of the data (a missing limit): both name flags
     raise_with_keywords(e, kExperimentFlags);
   }
 }
@@ -257,7 +257,7 @@ py::dict simulate(const Model& model, const Eigen::VectorXd& t, const Samples& q
     py::gil_scoped_release release;
     r = simulate_run(model, t, q, dq ? Eigen::MatrixXd(*dq) : Eigen::MatrixXd(),
                      ddq ? Eigen::MatrixXd(*ddq) : Eigen::MatrixXd(), options);
-  } catch (const UsageError& e) {
+  } catch (const Error& e) {  // a usage error or one of the data (a missing limit): both name flags
     raise_with_keywords(e, kExperimentFlags);
   }
   warn_all(warnings);
@@ -310,7 +310,7 @@ py::dict average(const Eigen::VectorXd& t, const py::dict& columns, const py::kw
   try {
     py::gil_scoped_release release;
     a = average_run(t, x, names, options);
-  } catch (const UsageError& e) {
+  } catch (const Error& e) {  // a usage error or one of the data (a missing limit): both name flags
     raise_with_keywords(e, kExperimentFlags);
   }
   warn_all(a.warnings);

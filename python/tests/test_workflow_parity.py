@@ -348,6 +348,9 @@ def test_bad_options_name_the_keyword(planar2):
         dynid.identify(planar2, t, q, tau, closed_loop="projection")
     with pytest.raises(dynid.Error, match="harmonics"):
         dynid.excite(planar2, harmonics=1)
+    # planar2 has no joint limits: the library's message names the keywords, not the flags.
+    with pytest.raises(dynid.Error, match="give velocity_limit or acceleration_limit"):
+        dynid.excite(planar2, max_time=0, starts=1, max_evaluations=50)
     with pytest.raises(dynid.Error, match="range"):
         dynid.excite(planar2, family="slope", joint=1, velocity=0.4, acceleration=2.0)
     with pytest.raises(ValueError, match="criterion is for the optimised excitation"):
