@@ -59,9 +59,12 @@ std::string parameter_unit(const Model& model, const std::string& name) {
     if (kind == inertia) return "kg·m²";
   }
   const bool prismatic = model.joints[joint - 1].type == JointType::kPrismatic;
-  if (kind == "Ia") return prismatic ? "kg" : "kg·m²";
-  if (kind == "Fv" || kind == "Fvp" || kind == "Fvn") return prismatic ? "N·s/m" : "N·m·s/rad";
-  if (kind == "Fc" || kind == "Fcp" || kind == "Fcn" || kind == "Fo") {
+  // Iam, Fvm, Fcm: a coupled motor's terms (coupling_column_names), in its joint's units.
+  if (kind == "Ia" || kind == "Iam") return prismatic ? "kg" : "kg·m²";
+  if (kind == "Fv" || kind == "Fvp" || kind == "Fvn" || kind == "Fvm") {
+    return prismatic ? "N·s/m" : "N·m·s/rad";
+  }
+  if (kind == "Fc" || kind == "Fcp" || kind == "Fcn" || kind == "Fcm" || kind == "Fo") {
     return prismatic ? "N" : "N·m";
   }
   return "";

@@ -2,6 +2,8 @@
 // (every third joint of random_tree(…, prismatic = true) is prismatic: joint 3 here).
 #include <gtest/gtest.h>
 
+#include "dynid/model/robots.hpp"
+#include "dynid/model/transmission.hpp"
 #include "dynid/regressor/parameter_layout.hpp"
 #include "support/random_models.hpp"
 
@@ -27,6 +29,13 @@ TEST(ParameterUnit, KindAndJointTypeGiveTheUnit) {
   for (const auto& name : ParameterLayout::full().names(model.dof())) {
     EXPECT_FALSE(parameter_unit(model, name).empty()) << name;
   }
+  // Coupled motors (the IRp-6's motor 3 turns with q2 + q3): every coupling column has a unit.
+  const Model irp6 = load_robot("irp6");
+  const std::vector<std::string> coupled = coupling_column_names(irp6);
+  ASSERT_FALSE(coupled.empty());
+  for (const auto& name : coupled) EXPECT_FALSE(parameter_unit(irp6, name).empty()) << name;
+  EXPECT_EQ(parameter_unit(irp6, "Fcm3"), "N·m");
+  EXPECT_EQ(parameter_unit(irp6, "Iam3"), "kg·m²");
   for (const char* other : {"Fo5", "XX0", "foo", "XX1Q", "M", "12", "XX99999"}) {
     EXPECT_EQ(parameter_unit(model, other), "") << other;
   }

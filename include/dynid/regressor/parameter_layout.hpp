@@ -36,9 +36,10 @@ struct ParameterLayout {
 
 /// The SI unit of a parameter named as ParameterLayout::names() and the base-parameter names make
 /// them (XX1 … M6, Ia2, Fvp3, Fc2R: a trailing R marks a regrouped base parameter, whose terms
-/// share the unit of the first): kg·m², kg·m, kg for link parameters; for joint j's terms those of
-/// its type, revolute Ia kg·m², Fv N·m·s/rad, Fc and Fo N·m, prismatic kg, N·s/m, N. Empty for a
-/// name of another form or a joint outside the model. No errors.
+/// share the unit of the first): kg·m², kg·m, kg for link parameters; for joint j's terms (and
+/// coupled motor j's Iam, Fvm, Fcm) those of its type, revolute Ia kg·m², Fv N·m·s/rad, Fc and Fo
+/// N·m, prismatic kg, N·s/m, N. Empty for a name of another form or a joint outside the model. No
+/// errors.
 std::string parameter_unit(const Model& model, const std::string& name);
 
 }  // namespace dynid
